@@ -1,0 +1,155 @@
+"""An assembled scene: numeric functions of the global coordinates."""
+from __future__ import annotations
+
+from functools import cached_property
+
+import casadi as ca
+import numpy as np
+import scipy.sparse as sps
+
+from ..codegen.library import kernel_library
+from ..scene.loads import NodalForce, SlopeMoment
+from ..scene.scene import Scene
+from .dofs import DofMap
+from .element_set import ElementSet
+from .sparse import to_scipy, vector_scatter
+
+
+class System:
+    """Global forces and matrices of a scene, built from compiled kernels.
+
+    The MX builders (``internal_force``, ``external_force``, ``tangent_stiffness``) are the
+    pieces the DAE layer composes; the ``eval_*`` helpers evaluate them numerically.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (bodies, loads, gravity).
+    """
+
+    def __init__(self, scene: Scene):
+        self.scene = scene
+        self.dofs = DofMap(scene.bodies)
+        self.n = self.dofs.n
+        self.element_sets: list[ElementSet] = []
+        by_type: dict[str, list] = {}
+        for body in scene.bodies:
+            by_type.setdefault(body.element.name, []).append(body)
+        for bodies in by_type.values():
+            idx = np.concatenate([self.dofs.element_indices(b) for b in bodies])
+            params = np.concatenate([b.params for b in bodies])
+            self.element_sets.append(ElementSet(bodies[0].element, idx, params, self.n))
+        self._moments = [load for load in scene.loads if isinstance(load, SlopeMoment)]
+
+    # --- MX builders ----------------------------------------------------------------------
+    def internal_force(self, q: ca.MX, q_dot: ca.MX | None = None) -> ca.MX:
+        """Elastic (and, given ``q_dot``, damping) generalized forces."""
+        f = ca.MX(self.n, 1)
+        for es in self.element_sets:
+            f += es.force(q)
+            if q_dot is not None and es.damped:
+                f += es.damping(q, q_dot)
+        return f
+
+    def tangent_stiffness(self, q: ca.MX) -> ca.MX:
+        """``-d internal_force / d q`` without damping (sparse)."""
+        k = ca.MX(self.n, self.n)
+        for es in self.element_sets:
+            k += es.stiffness(q)
+        return k
+
+    def external_force(self, q: ca.MX) -> ca.MX:
+        """Gravity, dead nodal forces and slope moments."""
+        return self.constant_load() + self._moment_force(q)
+
+    def _moment_force(self, q: ca.MX) -> ca.MX:
+        if not self._moments:
+            return ca.MX(self.n, 1)
+        lib = kernel_library("slope_moment")
+        slopes, params, targets = [], [], []
+        for load in self._moments:
+            body = self.scene.body(load.body)
+            dim = body.element.dim
+            names = body.element.node_coordinates[dim : 2 * dim]
+            idx = [self.dofs.index(body, load.node, c) for c in names]
+            a = q[idx]
+            slopes.append(ca.vertcat(a, ca.MX(3 - dim, 1)) if dim == 2 else a)
+            params.append(np.concatenate([[load.moment], load.unit_axis()]))
+            targets.append(idx + [-1] * (3 - dim))
+        f = lib["slope_moment"].map(len(slopes))(ca.horzcat(*slopes), ca.DM(np.array(params).T))
+        return ca.mtimes(vector_scatter(np.array(targets), self.n), ca.vec(f))
+
+    @cached_property
+    def _constant_load(self) -> np.ndarray:
+        f = np.zeros(self.n)
+        g = self.scene.gravity_vector()
+        if np.any(g != 0):
+            for es in self.element_sets:
+                f += es.gravity(g)
+        for load in self.scene.loads:
+            if isinstance(load, NodalForce):
+                body = self.scene.body(load.body)
+                idx = self.dofs.node_indices(body, load.node)[: body.element.dim]
+                f[idx] += np.asarray(load.force, dtype=float)
+        return f
+
+    def constant_load(self) -> ca.DM:
+        return ca.DM(self._constant_load)
+
+    # --- compiled numeric functions -------------------------------------------------------
+    @cached_property
+    def static_functions(self) -> ca.Function:
+        """``(q, load_factor) -> (residual, jacobian)`` of ``f_int(q) + lambda f_ext(q) = 0``."""
+        q = ca.MX.sym("q", self.n)
+        lam = ca.MX.sym("load_factor")
+        f_ext = self.external_force(q)
+        residual = self.internal_force(q) + lam * f_ext
+        jac = -self.tangent_stiffness(q)
+        if self._moments:
+            jac += lam * ca.jacobian(self._moment_force(q), q)
+        return ca.Function("static", [q, lam], [residual, jac], ["q", "load_factor"], ["residual", "jacobian"])
+
+    def eval_static(self, q: np.ndarray, load_factor: float) -> tuple[np.ndarray, sps.csc_matrix]:
+        r, j = self.static_functions(ca.DM(q), load_factor)
+        return np.asarray(r).ravel(), to_scipy(j)
+
+    @cached_property
+    def _energy_function(self) -> ca.Function:
+        q = ca.MX.sym("q", self.n)
+        u = sum((es.energy(q) for es in self.element_sets), ca.MX(0))
+        return ca.Function("energy", [q], [u])
+
+    def strain_energy(self, q: np.ndarray) -> float:
+        """Strain energy (J)."""
+        return float(self._energy_function(ca.DM(q)))
+
+    @cached_property
+    def mass_matrix(self) -> sps.csc_matrix:
+        """Global constant mass matrix."""
+        m = sps.csc_matrix((self.n, self.n))
+        for es in self.element_sets:
+            m = m + es.mass_matrix()
+        return sps.csc_matrix(m)
+
+    def external_force_value(self, q: np.ndarray) -> np.ndarray:
+        return self._constant_load + (np.asarray(self._ext_fn(ca.DM(q))).ravel() if self._moments else 0.0)
+
+    @cached_property
+    def _ext_fn(self) -> ca.Function:
+        q = ca.MX.sym("q", self.n)
+        return ca.Function("moments", [q], [self._moment_force(q)])
+
+    def body_slice(self, name: str) -> slice:
+        body = self.scene.body(name)
+        start = self.dofs.offset[name]
+        return slice(start, start + body.q0.size)
+
+    def body_set(self, name: str) -> ElementSet:
+        """Element set restricted to one body (for sampling its centre line)."""
+        body = self.scene.body(name)
+        return ElementSet(body.element, self.dofs.element_indices(body), body.params, self.n)
+
+
+def assemble(scene: Scene) -> System:
+    """Assemble a scene (loads only the kernel libraries its elements and loads use)."""
+    return System(scene)

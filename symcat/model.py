@@ -1,0 +1,264 @@
+"""Runnable models: declared parameters (defaults, units, ranges), a run function, a summary.
+
+A model file under ``models/`` defines ``MODEL = Model(...)``. :func:`run_model` (and the
+``symcat run`` command) finds it by name or path, validates the parameters, runs it and
+returns a :class:`RunResult` whose ``summary`` holds the model's named outputs plus
+``wall_s`` and the solver statistics.
+"""
+from __future__ import annotations
+
+import importlib.util
+import json
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+from .errors import ParameterError, SymcatError
+
+PACKAGE_DIR = Path(__file__).resolve().parent
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A model parameter.
+
+    Parameters
+    ----------
+    name : str
+        Name used with ``--set name=value``.
+    default : float, int, str or bool
+        Default value; its type is the parameter's type.
+    unit : str
+        SI unit ("-" for dimensionless, "" for choices).
+    doc : str
+        What it means.
+    minimum, maximum : float, optional
+        Allowed range; ``exclusive_minimum`` makes the lower bound strict (e.g. a length > 0).
+    choices : tuple of str, optional
+        Allowed values of a string parameter.
+    """
+
+    name: str
+    default: Any
+    unit: str
+    doc: str
+    minimum: float | None = None
+    maximum: float | None = None
+    exclusive_minimum: bool = False
+    choices: tuple[str, ...] | None = None
+
+    @property
+    def kind(self) -> type:
+        return type(self.default)
+
+    def allowed(self) -> str:
+        if self.choices:
+            return "one of " + ", ".join(self.choices)
+        if self.kind is bool:
+            return "true or false"
+        lo = "" if self.minimum is None else (f"> {self.minimum:g}" if self.exclusive_minimum else f">= {self.minimum:g}")
+        hi = "" if self.maximum is None else f"<= {self.maximum:g}"
+        rng = " and ".join(x for x in (lo, hi) if x)
+        what = "an integer" if self.kind is int else "a number"
+        return f"{what} {rng}".strip()
+
+    def _reject(self, value) -> ParameterError:
+        unit = f" {self.unit}" if self.unit not in ("", "-") else ""
+        return ParameterError(f"{self.name}={value}{unit}: must be {self.allowed()}")
+
+    def parse(self, text: str):
+        """Convert command-line text to the parameter's type and validate it."""
+        if self.kind is bool:
+            low = str(text).strip().lower()
+            if low in ("1", "true", "yes", "on"):
+                return True
+            if low in ("0", "false", "no", "off"):
+                return False
+            raise self._reject(text)
+        if self.kind in (int, float):
+            try:
+                value = float(text)
+            except ValueError:
+                raise self._reject(text) from None
+            if self.kind is int:
+                if value != int(value):
+                    raise self._reject(text)
+                value = int(value)
+            return self.validate(value)
+        return self.validate(str(text))
+
+    def validate(self, value):
+        """Check a Python value against type, range and choices; return it."""
+        if self.choices is not None:
+            if value not in self.choices:
+                raise self._reject(value)
+            return value
+        if self.kind in (int, float):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise self._reject(value)
+            if self.kind is int and value != int(value):
+                raise self._reject(value)
+            if self.minimum is not None and (value < self.minimum or (self.exclusive_minimum and value <= self.minimum)):
+                raise self._reject(value)
+            if self.maximum is not None and value > self.maximum:
+                raise self._reject(value)
+            return self.kind(value)
+        if self.kind is bool and not isinstance(value, bool):
+            raise self._reject(value)
+        return value
+
+
+@dataclass
+class ModelOutput:
+    """What a model's run function returns.
+
+    Attributes
+    ----------
+    summary : dict
+        Named outputs (JSON-serializable), units in the names.
+    stats : dict
+        Solver statistics.
+    arrays : dict
+        Named arrays for further use (units in the names).
+    writer : callable, optional
+        ``writer(out_dir)`` writes plots and ParaView files.
+    """
+
+    summary: dict
+    stats: dict = field(default_factory=dict)
+    arrays: dict = field(default_factory=dict)
+    writer: Callable[[Path], list] | None = None
+
+
+@dataclass
+class Model:
+    """A runnable model: parameters and a run function ``run(params: dict) -> ModelOutput``."""
+
+    name: str
+    description: str
+    parameters: list[Parameter]
+    run: Callable[[dict], ModelOutput]
+
+    def parameter(self, name: str) -> Parameter:
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        known = ", ".join(p.name for p in self.parameters)
+        raise ParameterError(f"{name}: not a parameter of model {self.name!r} (parameters: {known})")
+
+    def resolve(self, values: dict | None) -> dict:
+        """Defaults overridden by ``values`` (validated)."""
+        params = {p.name: p.default for p in self.parameters}
+        for name, value in (values or {}).items():
+            p = self.parameter(name)
+            params[name] = p.parse(value) if isinstance(value, str) and p.kind is not str else p.validate(value)
+        return params
+
+    def help(self) -> str:
+        lines = [f"{self.name}: {self.description}", "", "parameters (--set name=value):"]
+        for p in self.parameters:
+            unit = f" [{p.unit}]" if p.unit else ""
+            lines.append(f"  {p.name}{unit} = {p.default!r}  ({p.allowed()})")
+            lines.append(f"      {p.doc}")
+        return "\n".join(lines)
+
+
+@dataclass
+class RunResult:
+    """Result of :func:`run_model`: ``summary`` (outputs + ``wall_s`` + ``stats``), arrays, files."""
+
+    model: str
+    params: dict
+    summary: dict
+    arrays: dict
+    files: list
+
+
+def models_dirs() -> list[Path]:
+    dirs = []
+    if os.environ.get("SYMCAT_MODELS"):
+        dirs.append(Path(os.environ["SYMCAT_MODELS"]))
+    dirs += [Path.cwd() / "models", PACKAGE_DIR.parent / "models"]
+    return dirs
+
+
+def available_models() -> list[str]:
+    names = set()
+    for d in models_dirs():
+        if d.is_dir():
+            names.update(p.stem for p in d.glob("*.py") if not p.name.startswith("_"))
+    return sorted(names)
+
+
+def load_model(name_or_path: str) -> Model:
+    """Find a model by name (``models/<name>.py``) or by file path."""
+    path = Path(name_or_path)
+    if not (path.suffix == ".py" and path.is_file()):
+        path = next((d / f"{name_or_path}.py" for d in models_dirs() if (d / f"{name_or_path}.py").is_file()), None)
+        if path is None:
+            known = ", ".join(available_models()) or "none found"
+            raise ParameterError(f"model={name_or_path!r}: no such model (available: {known})")
+    spec = importlib.util.spec_from_file_location(f"symcat_model_{path.stem}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    model = getattr(module, "MODEL", None)
+    if not isinstance(model, Model):
+        raise SymcatError(f"{path}: defines no MODEL = symcat.model.Model(...)")
+    return model
+
+
+def run_model(model: str | Model, params: dict | None = None, out: str | Path | None = None,
+              summary_path: str | Path | None = None) -> RunResult:
+    """Run a model.
+
+    Parameters
+    ----------
+    model : str or Model
+        Model name (file under ``models/``), path, or object.
+    params : dict, optional
+        Parameter values (strings are parsed as on the command line).
+    out : path, optional
+        Folder for plots, ParaView files and ``summary.json``.
+    summary_path : path, optional
+        Where to write the summary JSON.
+    """
+    m = load_model(model) if isinstance(model, str) else model
+    values = m.resolve(params)
+    t0 = time.perf_counter()
+    output = m.run(values)
+    wall = time.perf_counter() - t0
+    summary = dict(output.summary)
+    summary["wall_s"] = wall
+    summary["stats"] = output.stats
+    files = []
+    if out is not None:
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        if output.writer is not None:
+            files += [str(f) for f in output.writer(out)]
+        _write_json(out / "summary.json", {"model": m.name, "parameters": values, **summary})
+        files.append(str(out / "summary.json"))
+    if summary_path is not None:
+        _write_json(Path(summary_path), summary)
+    return RunResult(m.name, values, summary, output.arrays, files)
+
+
+def _write_json(path: Path, data: dict) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(data, indent=1, default=_jsonable) + "\n")
+
+
+def _jsonable(x):
+    try:
+        import numpy as np
+
+        if isinstance(x, np.ndarray):
+            return x.tolist()
+        if isinstance(x, np.generic):
+            return x.item()
+    except ImportError:  # pragma: no cover
+        pass
+    raise TypeError(f"not JSON serializable: {type(x).__name__}")
