@@ -35,19 +35,24 @@ class SympyToCasadi:
         return self._convert(sp.sympify(expr))
 
     def _convert(self, root: sp.Basic) -> ca.SX:
-        # Iterative post-order walk: deep expressions must not hit Python's recursion limit.
+        # Iterative post-order walk over the DAG (each distinct node expanded once): deep
+        # expressions must not hit Python's recursion limit, and shared subtrees must not be
+        # walked once per path.
         cache = self.cache
-        stack = [root]
+        visited = set(cache)
+        order = []
+        stack = [(root, False)]
         while stack:
-            node = stack[-1]
-            if node in cache:
-                stack.pop()
+            node, ready = stack.pop()
+            if ready:
+                order.append(node)
                 continue
-            pending = [a for a in _operands(node) if a not in cache]
-            if pending:
-                stack.extend(pending)
+            if node in visited:
                 continue
-            stack.pop()
+            visited.add(node)
+            stack.append((node, True))
+            stack.extend((a, False) for a in _operands(node) if a not in visited)
+        for node in order:
             cache[node] = self._apply(node)
         return cache[root]
 

@@ -1,0 +1,39 @@
+# symcat developer targets. `make test` is the README's test command; CI runs it through .ci/run.
+PYTHON ?= python3
+VENV ?= .venv
+PY := $(VENV)/bin/python
+
+.PHONY: install generate check-generated compile test bench demo clean
+
+$(PY):
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --upgrade pip >/dev/null
+
+install: $(PY)
+	$(PY) -m pip install -e ".[test]"
+
+## Re-derive every kernel in SymPy and regenerate generated/*.c and the manifest.
+generate: install
+	$(PY) -m symcat.codegen generate
+	$(PY) -m symcat.codegen compile
+
+## Fail if the committed generated code is stale (source changed, or a file edited by hand).
+check-generated: install
+	$(PY) -m symcat.codegen check
+
+## Compile every kernel library into the cache.
+compile: install
+	$(PY) -m symcat.codegen compile
+
+test: install compile
+	$(PY) -m pytest -q
+
+bench: install compile
+	$(PY) -m bench.run
+
+demo: install
+	$(VENV)/bin/symcat run cantilever --out out/cantilever
+
+clean:
+	rm -rf out build *.egg-info .pytest_cache
+	rm -rf $${SYMCAT_CACHE:-$${XDG_CACHE_HOME:-$$HOME/.cache}/symcat}

@@ -1,0 +1,4 @@
+"""Outputs a user can look at: centre-line samples, ParaView files (meshio) and plots."""
+from .shapes import centerlines, plot_centerlines, write_centerlines_vtu, write_modes_vtu
+
+__all__ = ["centerlines", "plot_centerlines", "write_centerlines_vtu", "write_modes_vtu"]
