@@ -50,7 +50,9 @@ def run(p: dict) -> ModelOutput:
     end = np.zeros(dim)
     end[0] = p["span"]
     cable = AncfBody.straight("cable", element, np.zeros(dim), end, p["n_elements"], material, section, prestrain=prestrain)
-    _parabola_guess(cable, p["span"], 0.7 * _inextensible_sag(p["span"], length0))
+    # Start with 30 % too much sag: the guess is then stretched (in tension), never a slack
+    # compressed curve, from which Newton could wander to a buckled branch.
+    _parabola_guess(cable, p["span"], 1.3 * _inextensible_sag(p["span"], length0))
     cable.pin(0).pin(-1)
     if element == "beam3d":
         cable.fix(0, ["z_y", "y_z"])
@@ -97,3 +99,6 @@ def _parabola_guess(body: AncfBody, span: float, sag: float) -> None:
     if body.element.name == "beam3d":
         norm = np.sqrt(1 + dydx**2)
         q[:, 6], q[:, 7] = -dydx / norm, 1 / norm
+
+
+MODEL = Model("hanging_cable", "elastic catenary: a cable sagging under gravity between two supports", PARAMETERS, run)

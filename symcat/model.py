@@ -67,7 +67,8 @@ class Parameter:
 
     def _reject(self, value) -> ParameterError:
         unit = f" {self.unit}" if self.unit not in ("", "-") else ""
-        return ParameterError(f"{self.name}={value}{unit}: must be {self.allowed()}")
+        shown = f"{value:g}" if isinstance(value, float) else value
+        return ParameterError(f"{self.name}={shown}{unit}: must be {self.allowed()}")
 
     def parse(self, text: str):
         """Convert command-line text to the parameter's type and validate it."""

@@ -1,0 +1,86 @@
+"""Statics, modes and Cholesky coordinates on assembled systems."""
+from __future__ import annotations
+
+import importlib
+
+import numpy as np
+import pytest
+import scipy.sparse as sps
+
+from symcat.analysis import modes, solve_static
+from symcat.assembly import CholeskyCoordinates, assemble
+from symcat.errors import SolverError
+from symcat.scene import AncfBody, Material, NodalForce, Scene, Section
+
+
+def _wire(element="cable3d", n=12, prestrain=1e-3, gravity=(0.0, 0.0, 0.0)):
+    dim = 2 if element == "cable2d" else 3
+    end = np.zeros(dim)
+    end[0] = 10.0
+    wire = AncfBody.straight("w", element, np.zeros(dim), end, n, Material(1e11, 8900), Section.circle(0.012), prestrain=prestrain)
+    wire.pin(0).pin(-1)
+    scene = Scene(gravity=gravity)
+    scene.add(wire)
+    return scene, wire
+
+
+def test_cholesky_coordinates_make_the_mass_matrix_the_identity(rng):
+    scene, _ = _wire("beam3d", 6)
+    system = assemble(scene)
+    free = system.dofs.free
+    m = system.mass_matrix[free][:, free]
+    chol = CholeskyCoordinates(m)
+    u = chol.factor().toarray()
+    assert np.allclose(np.triu(u), u)
+    np.testing.assert_allclose(u.T @ u, m.toarray(), rtol=1e-12, atol=1e-12 * abs(m).max())
+    e_dot = rng.standard_normal(free.size)
+    p_dot = chol.to_cholesky(e_dot)
+    assert 0.5 * p_dot @ p_dot == pytest.approx(0.5 * e_dot @ (m @ e_dot), rel=1e-12)  # identity mass
+    np.testing.assert_allclose(chol.from_cholesky(p_dot), e_dot, rtol=1e-9, atol=1e-9)
+    q_e = rng.standard_normal(free.size)
+    # Virtual work is invariant: Q_p . dp = Q_e . de.
+    assert chol.force_to_cholesky(q_e) @ p_dot == pytest.approx(q_e @ e_dot, rel=1e-9)
+    assert chol.bandwidth < 2 * 24  # banded along the chain: the factor is sparse
+
+
+def test_mass_matrix_total_mass_and_sparsity():
+    scene, wire = _wire("cable3d", 10)
+    system = assemble(scene)
+    m = system.mass_matrix
+    v = np.zeros(system.n)
+    v[0::6] = 1.0  # rigid x translation: position x-coordinates only
+    assert v @ (m @ v) == pytest.approx(wire.mass(), rel=1e-12)
+    assert sps.issparse(m) and m.nnz < 0.2 * system.n**2
+
+
+def test_sparse_and_dense_eigensolvers_agree(monkeypatch):
+    scene, _ = _wire("cable2d", 30)
+    system = assemble(scene)
+    q = solve_static(system).q
+    dense = modes(system, q, 6).frequencies_hz
+    monkeypatch.setattr(importlib.import_module("symcat.analysis.modes"), "DENSE_LIMIT", 0)
+    sparse = modes(system, q, 6).frequencies_hz
+    np.testing.assert_allclose(sparse, dense, rtol=1e-9)
+
+
+def test_gravity_sag_balances_the_weight():
+    """Support reactions of a sagging wire sum to its weight (global equilibrium)."""
+    scene, wire = _wire("cable3d", 16, prestrain=2e-4, gravity=(0.0, 0.0, -9.81))
+    system = assemble(scene)
+    q = solve_static(system).q
+    residual = system.eval_static(q, 1.0)[0]  # zero on free coordinates; minus the reactions on fixed ones
+    assert np.abs(residual[system.dofs.free]).max() < 1e-6
+    vertical = [system.dofs.index(wire, node, "z") for node in (0, -1)]
+    assert -residual[vertical].sum() == pytest.approx(wire.mass() * 9.81, rel=1e-9)
+
+
+def test_a_mechanism_fails_with_a_clear_error_and_keeps_the_partial_result():
+    wire = AncfBody.straight("w", "cable2d", [0, 0], [1, 0], 4, Material(1e9, 1000), Section.circle(0.01))
+    wire.pin(0)  # free to swing: no static equilibrium under a transverse load
+    scene = Scene()
+    scene.add(wire)
+    scene.add(NodalForce("w", -1, (0.0, -1.0)))
+    with pytest.raises(SolverError) as info:
+        solve_static(assemble(scene), max_iterations=8, min_step=0.05)
+    assert "load factor" in str(info.value) and info.value.partial is not None
+    assert info.value.partial.load_factor < 1
