@@ -176,3 +176,39 @@ def test_slope_moment_is_the_gradient_of_the_rotation_angle(rng):
     angle = lambda x: np.arctan2(x @ e2, x @ e1)
     grad = np.array([(angle(a + h) - angle(a - h)) / 2e-7 for h in np.eye(3) * 1e-7])
     np.testing.assert_allclose(f, moment * grad, rtol=1e-6)
+
+
+@pytest.mark.parametrize("name", ELEMENT_NAMES)
+def test_position_and_strain_kernels_against_sympy(name, rng):
+    defn = ELEMENTS[name]()
+    lib = kernel_library(name)
+    p = parameters(name, rng, prestrain=0.01)
+    e = deformed(name, p[0], rng)
+    xi = 0.37
+    r = sp.lambdify([defn.e, defn.xi, defn.p], defn.position, "numpy")(e, xi, p)
+    r_x = sp.lambdify([defn.e, defn.xi, defn.p], defn.slope, "numpy")(e, xi, p)
+    got_r, got_rx = _call(lib[f"{name}_position"], e, xi, p)
+    np.testing.assert_allclose(got_r.ravel(), np.ravel(r), rtol=1e-13)
+    np.testing.assert_allclose(got_rx.ravel(), np.ravel(r_x), rtol=1e-13)
+    g = np.asarray(sp.lambdify([defn.xi, defn.p], defn.local_map, "numpy")(xi, p), dtype=float) @ e
+    eps = float(sp.lambdify([defn.local, defn.p], defn.axial_strain, "numpy")(g, p))
+    kappa = np.ravel(sp.lambdify([defn.local, defn.p], defn.bending_strain, "numpy")(g, p))
+    got = _call(lib[f"{name}_strain"], e, xi, p)
+    assert got[0].item() == pytest.approx(eps, rel=1e-12)
+    np.testing.assert_allclose(got[1].ravel(), kappa, rtol=1e-11, atol=1e-14)
+
+
+def test_casadi_differentiates_through_the_compiled_externals():
+    """AD of an assembled MX graph uses the jac_<name> companions: it equals the stiffness."""
+    from symcat.assembly import assemble
+    from symcat.scene import AncfBody, Material, Scene, Section
+
+    wire = AncfBody.straight("w", "cable3d", [0, 0, 0], [3, 0, 0], 5, Material(1e10, 2000), Section.circle(0.01), prestrain=1e-3)
+    scene = Scene()
+    scene.add(wire)
+    system = assemble(scene)
+    q = ca.MX.sym("q", system.n)
+    fn = ca.Function("f", [q], [ca.jacobian(system.internal_force(q), q), system.tangent_stiffness(q)])
+    q0 = system.dofs.q0 + 0.01 * np.random.default_rng(3).standard_normal(system.n)
+    jac, k = (np.asarray(ca.densify(m)) for m in fn(q0))
+    np.testing.assert_allclose(jac, -k, rtol=1e-12, atol=1e-12 * np.abs(k).max())
