@@ -96,11 +96,8 @@ def solve_static(
     total_iterations, accepted, history = 0, 0, []
     bar = Progress("statics", total=1.0, unit="load", enabled=progress)
 
-    # Equilibrate the internal forces first (prestrain with no external load).
-    ok, q_try, its, reason = _newton(system, q, 0.0, free, scale, rtol, max_iterations)
-    total_iterations += its
-    if ok:
-        q = q_try
+    # Step from the initial state straight towards the first load level: a slack cable has no
+    # equilibrium without its load, so lambda = 0 itself is not solved first.
     while lam < 1.0:
         target = min(1.0, lam + step)
         ok, q_try, its, reason = _newton(system, q, target, free, scale, rtol, max_iterations)
@@ -135,6 +132,35 @@ def _load_scale(system: System, q: np.ndarray) -> float:
     return max(np.abs(f_ext).max(initial=0.0), np.abs(r0).max(initial=0.0), 1.0)
 
 
+def _line_search(system, q, dq, free, lam, s0, max_trials=5):
+    """Step length along ``dq`` that makes the slope ``dq . R`` small (secant iterations)."""
+    def trial(alpha):
+        q_a = q.copy()
+        q_a[free] += alpha * dq
+        r_a, j_a = system.eval_static(q_a, lam)
+        return q_a, r_a, j_a, dq @ r_a[free]
+
+    best = None
+    a_prev, s_prev = 0.0, s0
+    alpha = 1.0
+    for _ in range(max_trials):
+        q_a, r_a, j_a, s_a = trial(alpha)
+        if not np.isfinite(s_a):
+            alpha /= 4
+            continue
+        if best is None or abs(s_a) < abs(best[4]):
+            best = (q_a, r_a, j_a, alpha, s_a)
+        if abs(s_a) <= 0.5 * abs(s0):
+            break
+        denom = s_a - s_prev
+        step = alpha - s_a * (alpha - a_prev) / denom if denom != 0 else 2 * alpha
+        a_prev, s_prev = alpha, s_a
+        alpha = float(np.clip(step, 0.05, 4.0))
+    if best is None:
+        return (*trial(1e-3)[:3], 1e-3)
+    return best[0], best[1], best[2], best[3]
+
+
 def _newton(system, q, lam, free, scale, rtol, max_iterations, xtol=1e-10):
     """Damped Newton iteration at a fixed load factor; returns (ok, q, iterations, reason)."""
     q = q.copy()
@@ -157,12 +183,12 @@ def _newton(system, q, lam, free, scale, rtol, max_iterations, xtol=1e-10):
             # get below ~1e-16 EA, whatever the force tolerance says.
             q[free] += dq
             return True, q, it, ""
-        # Full Newton steps: the residual norm is a poor merit function for wires (a small
-        # transverse step excites EA-sized axial residuals that the next step removes), so
-        # divergence is caught by the load-step control instead of a line search.
-        q = q.copy()
-        q[free] += dq
-        r, jac = system.eval_static(q, lam)
+        # Line search on the slope s(alpha) = dq . R(q + alpha dq) of the total potential along
+        # dq (Crisfield): the residual norm itself is a poor merit function for wires, where a
+        # good transverse step leaves large axial residuals that the next step removes.
+        s0 = dq @ r[free]
+        q_new, r_new, jac_new, alpha = _line_search(system, q, dq, free, lam, s0)
+        q, r, jac = q_new, r_new, jac_new
         norm = np.abs(r[free]).max(initial=0.0)
         if not np.isfinite(norm):
             return False, q, it, "non-finite residual"
