@@ -18,6 +18,7 @@ import casadi as ca
 import numpy as np
 
 import matplotlib
+import matplotlib.ticker
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -83,6 +84,7 @@ def accuracy_studies():
         axes[0, col].set_xlabel("elements")
         axes[1, col].set_xlabel("wall time per solve [ms]")
         for ax in axes[:, col]:
+            ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
             ax.grid(True, which="both", alpha=0.3)
             ax.set_ylabel("relative error")
             ax.legend(fontsize=8)
@@ -220,7 +222,10 @@ def main():
         "",
         "Relative errors: cantilever and roll-up tip position over L; taut wire: the largest relative "
         "error of the ten lowest in-plane frequencies; catenary: sag (EI = 1e-3 N m^2, the reference has none). "
-        "Wall time: one complete model run (assembly, static solve, modes), kernels already compiled.",
+        "Wall time: one complete model run (assembly, static solve, modes), kernels already compiled. "
+        "The taut-wire error levels off near 1e-6: the reference treats EI as the bending stiffness of the "
+        "tensioned wire, the elements of the stress-free wire (prestrain T/EA = 1.1e-3 changes the bending "
+        "term, itself 0.3 % of the tenth frequency, by that fraction).",
         "",
         "| study | element | elements | relative error | wall [ms] |",
         "|---|---|---:|---:|---:|",
