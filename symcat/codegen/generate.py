@@ -45,6 +45,7 @@ def generate_library(name: str, out_dir: Path | None = None) -> dict:
         "source_hash": digest,
         "c_sha256": file_sha256(path),
         "functions": [f.name() for f in functions],
+        "interface": kernels.library_interface(name),
         **tool_versions(),
     }
     return {**entry, "derive_s": t1 - t0, "generate_s": t2 - t1}

@@ -186,7 +186,9 @@ def _jacobian(f: ca.Function) -> ca.Function:
 
 def library_names() -> list[str]:
     """Every kernel library symcat can generate."""
-    return sorted(ELEMENTS) + sorted(LOADS)
+    from .multibody_kernels import multibody_library_names
+
+    return sorted(ELEMENTS) + sorted(LOADS) + multibody_library_names()
 
 
 def library_functions(name: str) -> list[ca.Function]:
@@ -195,4 +197,17 @@ def library_functions(name: str) -> list[ca.Function]:
         return element_functions(ELEMENTS[name]())
     if name in LOADS:
         return load_functions(name)
+    from .multibody_kernels import multibody_functions, multibody_library_names
+
+    if name in multibody_library_names():
+        return multibody_functions(name)
     raise KeyError(f"library={name!r}: unknown; known: {', '.join(library_names())}")
+
+
+def library_interface(name: str) -> dict:
+    """What the runtime needs to know about a library besides its functions (manifest)."""
+    if name in ELEMENTS or name in LOADS:
+        return {"kind": "element" if name in ELEMENTS else "load"}
+    from .multibody_kernels import interface
+
+    return interface(name)

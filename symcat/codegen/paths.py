@@ -16,6 +16,7 @@ SOURCE_FILES = sorted(
     [*(PACKAGE_DIR / "symbolic").glob("*.py"),
      PACKAGE_DIR / "catalog.py",
      PACKAGE_DIR / "codegen" / "kernels.py",
+     PACKAGE_DIR / "codegen" / "multibody_kernels.py",
      PACKAGE_DIR / "codegen" / "sympy_to_casadi.py",
      PACKAGE_DIR / "codegen" / "generate.py"]
 )
