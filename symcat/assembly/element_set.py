@@ -46,7 +46,7 @@ class ElementSet:
 
     def _scatter_matrix(self, mapped: ca.MX) -> ca.MX:
         if self._mat_scatter is None:
-            self._mat_scatter = MatrixScatter(self.indices, self.n_global, self.lib[f"{self.element.name}_stiffness"].sparsity_out(0))
+            self._mat_scatter = MatrixScatter.square(self.indices, self.n_global, self.lib[f"{self.element.name}_stiffness"].sparsity_out(0))
         return self._mat_scatter(mapped)
 
     # --- symbolic (MX) pieces for the assembled functions ---------------------------------

@@ -36,42 +36,46 @@ def vector_scatter(indices: np.ndarray, n_global: int) -> ca.DM:
 
 
 class MatrixScatter:
-    """Adds element matrices (stacked as ``vec`` of an (n_loc x n_loc*N) map output) into a
-    global sparse matrix.
+    """Adds element matrices (stacked as ``vec`` of an (n_r x n_c*N) map output) into a global
+    sparse matrix.
 
     Parameters
     ----------
-    indices : ndarray (N, n_loc)
-        Global index of each local coordinate of each element.
-    n_global : int
-        Size of the global matrix.
+    rows, cols : ndarray (N, n_r) and (N, n_c)
+        Global row and column of each local row and column of each element.
+    shape : (int, int)
+        Shape of the global matrix.
     local_sparsity : casadi.Sparsity
         Sparsity of one element matrix (only its nonzeros are scattered).
     """
 
-    def __init__(self, indices: np.ndarray, n_global: int, local_sparsity: ca.Sparsity):
-        n_el, n_loc = indices.shape
+    def __init__(self, rows: np.ndarray, cols: np.ndarray, shape, local_sparsity: ca.Sparsity):
+        rows, cols = np.asarray(rows, np.int64), np.asarray(cols, np.int64)
+        n_el, n_r = rows.shape
+        n_c = cols.shape[1]
         colind, row = local_sparsity.get_ccs()
-        col = np.repeat(np.arange(n_loc), np.diff(colind))
-        row = np.asarray(row)
-        nnz = row.size
-        g_row = indices[:, row].ravel()          # element-major, then local nonzero order
-        g_col = indices[:, col].ravel()
-        pattern = sps.csc_matrix((np.ones(g_row.size), (g_row, g_col)), shape=(n_global, n_global))
+        col = np.repeat(np.arange(n_c), np.diff(colind))
+        row = np.asarray(row, dtype=np.int64)
+        g_row = rows[:, row].ravel()          # element-major, then local nonzero order
+        g_col = cols[:, col].ravel()
+        n_rows, n_cols = shape
+        pattern = sps.csc_matrix((np.ones(g_row.size), (g_row, g_col)), shape=shape)
         pattern.sum_duplicates()
         pattern.sort_indices()
-        self.sparsity = ca.Sparsity(n_global, n_global, pattern.indptr.tolist(), pattern.indices.tolist())
+        self.sparsity = ca.Sparsity(n_rows, n_cols, pattern.indptr.tolist(), pattern.indices.tolist())
         # Position of each (row, col) pair among the global nonzeros (CSC order).
-        key = pattern.indices.astype(np.int64) + n_global * np.repeat(np.arange(n_global), np.diff(pattern.indptr)).astype(np.int64)
-        pos = np.searchsorted(key, g_row.astype(np.int64) + n_global * g_col.astype(np.int64))
-        # Local nonzeros of element k sit at k * (n_loc * n_loc) + linear index in vec(map output).
-        local_linear = row + n_loc * col
-        src = (np.arange(n_el)[:, None] * (n_loc * n_loc) + local_linear[None, :]).ravel()
-        t = sps.csc_matrix((np.ones(src.size), (pos, src)), shape=(pattern.nnz, n_el * n_loc * n_loc))
+        key = pattern.indices.astype(np.int64) + n_rows * np.repeat(np.arange(n_cols), np.diff(pattern.indptr)).astype(np.int64)
+        pos = np.searchsorted(key, g_row + n_rows * g_col)
+        # Local nonzeros of element k sit at k * (n_r * n_c) + linear index in vec(map output).
+        src = (np.arange(n_el)[:, None] * (n_r * n_c) + (row + n_r * col)[None, :]).ravel()
+        t = sps.csc_matrix((np.ones(src.size), (pos, src)), shape=(pattern.nnz, n_el * n_r * n_c))
         self.transfer = to_casadi_sparse(t)
-        self.nnz_local = nnz
+
+    @classmethod
+    def square(cls, indices: np.ndarray, n_global: int, local_sparsity: ca.Sparsity) -> "MatrixScatter":
+        return cls(indices, indices, (n_global, n_global), local_sparsity)
 
     def __call__(self, mapped: ca.MX) -> ca.MX:
-        """Global sparse matrix from the mapped element matrices ``mapped`` (n_loc x n_loc*N)."""
+        """Global sparse matrix from the mapped element matrices ``mapped``."""
         nz = ca.mtimes(self.transfer, ca.vec(ca.densify(mapped)))
         return ca.sparsity_cast(nz, self.sparsity)

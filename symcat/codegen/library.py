@@ -118,3 +118,9 @@ def kernel_library(name: str) -> KernelLibrary:
         lib = KernelLibrary(name, so)
         _LOADED[name] = lib
     return lib
+
+
+def library_interface(name: str) -> dict:
+    """Sizes and parameter names of a multibody library, from the manifest (no SymPy)."""
+    ensure_generated(name)
+    return read_manifest()["libraries"][name]["interface"]

@@ -1,7 +1,13 @@
-"""What the user describes: ANCF bodies, materials and sections, supports and loads."""
+"""What the user describes: ANCF and rigid bodies, joints, force elements, supports and loads."""
 from .ancf import AncfBody
+from .forces import PointLoad, RotationalSpring, SpringDamper
+from .joints import GROUND, Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical
 from .loads import NodalForce, SlopeMoment
+from .rigid import RigidBody
 from .scene import Scene
 from .sections import Material, Section
 
-__all__ = ["AncfBody", "Material", "NodalForce", "Scene", "Section", "SlopeMoment"]
+__all__ = [
+    "GROUND", "AncfBody", "Driving", "Fixed", "Material", "NodalForce", "PointLoad", "Prismatic", "Revolute",
+    "RigidBody", "RotationalSpring", "Scene", "Section", "SlidingJoint", "SlopeMoment", "Spherical", "SpringDamper",
+]

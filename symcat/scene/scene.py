@@ -8,7 +8,13 @@ import numpy as np
 
 from ..errors import ParameterError
 from .ancf import AncfBody
+from .forces import PointLoad, RotationalSpring, SpringDamper
+from .joints import Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical
 from .loads import NodalForce, SlopeMoment
+from .rigid import RigidBody
+
+JOINT_TYPES = (Spherical, Revolute, Prismatic, Fixed, Driving, SlidingJoint)
+FORCE_TYPES = (SpringDamper, RotationalSpring, PointLoad)
 
 
 @dataclass
@@ -24,13 +30,25 @@ class Scene:
     gravity: tuple[float, float, float] = (0.0, 0.0, 0.0)
     bodies: list[AncfBody] = field(default_factory=list)
     loads: list[NodalForce | SlopeMoment] = field(default_factory=list)
+    rigid_bodies: list[RigidBody] = field(default_factory=list)
+    joints: list = field(default_factory=list)
+    force_elements: list = field(default_factory=list)
 
     def add(self, item):
-        """Add a body or a load and return it."""
-        if isinstance(item, AncfBody):
-            if any(b.name == item.name for b in self.bodies):
+        """Add a body, joint, force element or load and return it."""
+        if isinstance(item, (AncfBody, RigidBody)):
+            if item.name == "ground" or item.name in self.body_names():
                 raise ParameterError(f"body name {item.name!r}: already used in this scene")
-            self.bodies.append(item)
+            (self.bodies if isinstance(item, AncfBody) else self.rigid_bodies).append(item)
+        elif isinstance(item, JOINT_TYPES + FORCE_TYPES):
+            names = [x.name for x in self.joints + self.force_elements]
+            if item.name in names:
+                raise ParameterError(f"name {item.name!r}: already used by a joint or force element")
+            for ref in _body_refs(item):
+                self.check_body_ref(ref, item.name)
+            if isinstance(item, SlidingJoint) and not isinstance(self.find(item.wire), AncfBody):
+                raise ParameterError(f"sliding joint {item.name!r}: wire={item.wire!r} is not an ANCF body")
+            (self.joints if isinstance(item, JOINT_TYPES) else self.force_elements).append(item)
         elif isinstance(item, (NodalForce, SlopeMoment)):
             body = self.body(item.body)
             body.node_index(item.node)
@@ -43,6 +61,31 @@ class Scene:
             raise ParameterError(f"cannot add {type(item).__name__} to a scene")
         return item
 
+    def body_names(self) -> list[str]:
+        return [b.name for b in self.bodies] + [b.name for b in self.rigid_bodies]
+
+    def find(self, name: str):
+        """The ANCF or rigid body called ``name``."""
+        for b in self.bodies + self.rigid_bodies:
+            if b.name == name:
+                return b
+        known = ", ".join(self.body_names()) or "none"
+        raise ParameterError(f"body={name!r}: no such body in the scene (bodies: {known})")
+
+    def check_body_ref(self, ref, owner: str) -> None:
+        """Validate a body reference: a rigid body name, "ground", or (ancf_body, node)."""
+        if ref == "ground":
+            return
+        if isinstance(ref, tuple):
+            body = self.find(ref[0])
+            if not isinstance(body, AncfBody):
+                raise ParameterError(f"{owner}: ({ref[0]!r}, {ref[1]}) names a node but {ref[0]!r} is not an ANCF body")
+            body.node_index(ref[1])
+            return
+        body = self.find(ref) if isinstance(ref, str) else None
+        if not isinstance(body, RigidBody):
+            raise ParameterError(f"{owner}: body {ref!r} must be a rigid body, 'ground' or (ancf_body, node)")
+
     def body(self, name: str) -> AncfBody:
         for b in self.bodies:
             if b.name == name:
@@ -52,3 +95,11 @@ class Scene:
 
     def gravity_vector(self) -> np.ndarray:
         return np.asarray(self.gravity, dtype=float)
+
+
+def _body_refs(item) -> list:
+    if isinstance(item, SlidingJoint):
+        return [item.body]
+    if isinstance(item, (Driving, PointLoad)):
+        return [item.body]
+    return [item.body_i, item.body_j]

@@ -1,0 +1,433 @@
+"""Assembly of a multibody scene: ANCF bodies, rigid bodies, constraints and force elements.
+
+Coordinates are laid out as ``q = [ANCF coordinates of every body | rigid-body coordinates
+(R, theta), 7 per body]``; the non-generalized arc-length parameters ``s`` of the sliding joints
+form a separate vector. Everything here builds CasADi MX expressions from the mapped, compiled
+kernels; :mod:`symcat.dae` composes them into the equations of motion.
+
+Sliding joints use a *global arc-length map*: ``s`` is measured along the whole wire, and the
+element that contains it is selected inside a window of elements by masks
+``(S_k <= s < S_k+1)``, which have zero derivative. The selected element's coordinates and
+``s - S_k`` go to the element kernel, so ``s``, its rate and the constraint force are continuous
+across element ends (the ANCF interpolation is C1 there). The window moves with the contact
+point; :mod:`symcat.integrate` restarts the integrator, with the same state, when ``s`` nears
+its edge.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from ..codegen.library import kernel_library, library_interface
+from ..errors import ParameterError
+from ..scene.ancf import AncfBody
+from ..scene.forces import PointLoad, RotationalSpring, SpringDamper
+from ..scene.joints import Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical, perpendiculars, unit
+from ..scene.rigid import RigidBody
+from ..scene.scene import Scene
+from .sparse import MatrixScatter, to_casadi_sparse, vector_scatter
+from .system import System
+
+import scipy.sparse as sps
+
+
+@dataclass
+class Side:
+    kind: str               # ground, rigid or node
+    indices: list[int]      # global coordinate indices
+    body: object = None
+    local: dict = field(default_factory=dict)
+
+
+@dataclass
+class KernelGroup:
+    """Instances of one constraint or force library (plain gathers of q)."""
+
+    library: str
+    rows: list = field(default_factory=list)      # per instance: global indices of y
+    params: list = field(default_factory=list)    # per instance: parameter vector
+    names: list = field(default_factory=list)     # per instance: joint/force name
+
+
+@dataclass
+class Sliding:
+    joint: SlidingJoint
+    wire: AncfBody
+    body: RigidBody
+    library: str
+    s_index: int
+    element_start: np.ndarray      # arc length at the start of each element (m)
+    element_indices: np.ndarray    # (n_el, n_loc) global coordinate indices
+    params: np.ndarray
+    window: tuple[int, int] = (0, 0)
+
+
+class MultibodyModel:
+    """Assembled multibody scene (see the module docstring).
+
+    Parameters
+    ----------
+    scene : Scene
+        ANCF bodies, rigid bodies, joints, force elements and loads.
+    window : int
+        Elements in the moving window of each sliding joint.
+    """
+
+    def __init__(self, scene: Scene, window: int = 16):
+        self.scene = scene
+        self.ancf = System(scene)
+        n_a = self.ancf.n
+        self.rigid_offset = {b.name: n_a + 7 * k for k, b in enumerate(scene.rigid_bodies)}
+        self.n_q = n_a + 7 * len(scene.rigid_bodies)
+        self.q0 = np.concatenate([self.ancf.dofs.q0, *[b.q0 for b in scene.rigid_bodies]]) if self.n_q else np.zeros(0)
+        self.v0 = np.concatenate([np.zeros(n_a), *[b.v0 for b in scene.rigid_bodies]]) if self.n_q else np.zeros(0)
+        fixed = np.concatenate([self.ancf.dofs.fixed, np.zeros(7 * len(scene.rigid_bodies), bool)])
+        self.free = np.flatnonzero(~fixed)
+        self.window_size = int(window)
+        self.groups: dict[str, KernelGroup] = {}
+        self.force_groups: dict[str, KernelGroup] = {}
+        self.sliding: list[Sliding] = []
+        self.row_names: list[str] = []
+        for body in scene.rigid_bodies:
+            self._add("normalization_rigid", body.name, [Side("rigid", self._rigid_indices(body.name), body)], {})
+        for joint in scene.joints:
+            self._add_joint(joint)
+        for force in scene.force_elements:
+            self._add_force(force)
+        self.n_s = len(self.sliding)
+        self.s0 = np.array([sl.joint.s0 for sl in self.sliding])
+        for sl in self.sliding:
+            self.set_window(sl, sl.joint.s0)
+        self._group_rows()
+
+    # --- bookkeeping ------------------------------------------------------------------------
+    def _rigid_indices(self, name: str) -> list[int]:
+        start = self.rigid_offset[name]
+        return list(range(start, start + 7))
+
+    def side(self, ref, point) -> Side:
+        """Kind, coordinates and local geometry of one end of a joint or force element."""
+        point = np.asarray(point, float)
+        if ref == "ground":
+            return Side("ground", [], None, {"u": point, "R": np.eye(3)})
+        if isinstance(ref, tuple):
+            body = self.scene.find(ref[0])
+            if body.element.dim != 3:
+                raise ParameterError(f"({ref[0]!r}, {ref[1]}): joints and springs need a 3D ANCF body, not {body.element.name}")
+            idx = self.ancf.dofs.node_indices(body, ref[1])[:3].tolist()
+            return Side("node", idx, body, {"u": point - body.q0[body.node_index(ref[1]), :3], "R": np.eye(3)})
+        body = self.scene.find(ref)
+        return Side("rigid", self._rigid_indices(body.name), body, {"u": body.local(point), "R": body.rotation})
+
+    def _add(self, library: str, name: str, sides: list[Side], values: dict, group=None):
+        groups = self.groups if group is None else group
+        info = library_interface(library)
+        g = groups.setdefault(library, KernelGroup(library))
+        try:
+            params = [values[p] for p in info["params"]]
+        except KeyError as exc:
+            raise RuntimeError(f"{library}: no value for parameter {exc}") from None
+        g.rows.append(sum((s.indices for s in sides), []))
+        g.params.append(params)
+        g.names.append(name)
+
+    @staticmethod
+    def _vectors(values: dict, side: Side, tag: str, **global_vectors):
+        """Body-frame components of global vectors (ground: global components)."""
+        for name, vec in global_vectors.items():
+            local = side.local["R"].T @ np.asarray(vec, float)
+            values.update({f"{name}{tag}_{k}": local[k] for k in range(3)})
+
+    def _add_joint(self, joint):
+        if isinstance(joint, SlidingJoint):
+            self._add_sliding(joint)
+            return
+        if isinstance(joint, Driving):
+            side = self.side(joint.body, joint.at if joint.at is not None else self.scene.find(joint.body).position)
+            n = unit(joint.direction, f"{joint.name}.direction")
+            point = np.asarray(joint.at if joint.at is not None else side.body.position, float)
+            values = {f"n_{k}": n[k] for k in range(3)}
+            values.update({f"ui_{k}": side.local["u"][k] for k in range(3)})
+            values.update(x0=float(n @ point), velocity=joint.velocity, amplitude=joint.amplitude,
+                          omega=2 * np.pi * joint.frequency, phase=joint.phase)
+            values.update({f"uj_{k}": 0.0 for k in range(3)})
+            self._add("driving_rigid_ground", joint.name, [side], values)
+            return
+        a = self.side(joint.body_i, joint.at)
+        b = self.side(joint.body_j, joint.at)
+        if a.kind == "ground":
+            raise ParameterError(f"joint {joint.name!r}: body_i must not be the ground (swap the bodies)")
+        kind = {Spherical: "spherical", Revolute: "revolute", Prismatic: "prismatic", Fixed: "fixed"}[type(joint)]
+        library = f"{kind}_{a.kind}_{b.kind}"
+        if library not in _available():
+            raise ParameterError(f"joint {joint.name!r}: {kind} between a {a.kind} and a {b.kind} body is not supported")
+        values = {f"ui_{k}": a.local["u"][k] for k in range(3)}
+        values.update({f"uj_{k}": b.local["u"][k] for k in range(3)})
+        if kind == "revolute":
+            x, y = perpendiculars(joint.axis)
+            self._vectors(values, a, "i", z=unit(joint.axis, f"{joint.name}.axis"))
+            self._vectors(values, b, "j", x=x, y=y)
+        elif kind == "prismatic":
+            axis = unit(joint.axis, f"{joint.name}.axis")
+            n1, n2 = perpendiculars(axis)
+            self._vectors(values, a, "i", n1=n1, n2=n2)
+            self._vectors(values, b, "j", m1=n1, a=axis)
+        elif kind == "fixed":
+            eye = np.eye(3)
+            self._vectors(values, a, "i", x=eye[0], y=eye[1], z=eye[2])
+            self._vectors(values, b, "j", x=eye[0], y=eye[1], z=eye[2])
+        self._add(library, joint.name, [a, b], values)
+
+    def _add_sliding(self, joint: SlidingJoint):
+        wire = self.scene.find(joint.wire)
+        body = self.scene.find(joint.body)
+        if not isinstance(body, RigidBody):
+            raise ParameterError(f"sliding joint {joint.name!r}: body={joint.body!r} must be a rigid body")
+        if wire.element.name not in ("cable3d", "beam3d"):
+            raise ParameterError(f"sliding joint {joint.name!r}: wire {wire.name!r} is {wire.element.name}; a sliding joint needs cable3d or beam3d")
+        lengths = wire.params[:, 0]
+        starts = np.concatenate([[0.0], np.cumsum(lengths)])
+        if not 0 <= joint.s0 <= starts[-1]:
+            raise ParameterError(f"sliding joint {joint.name!r}: s0={joint.s0:g} m must lie on the wire, in [0, {starts[-1]:g}] m")
+        library = f"sliding_{wire.element.name}_rigid"
+        info = library_interface(library)
+        point = body.position if joint.at is None else joint.at
+        u = body.local(point)
+        d_ref = unit(joint.reference_direction, f"{joint.name}.reference_direction")
+        values = {"L": 0.0, **{f"d_ref_{k}": d_ref[k] for k in range(3)}, **{f"uj_{k}": u[k] for k in range(3)}}
+        params = np.array([values[p] for p in info["params"]])
+        self.sliding.append(Sliding(joint, wire, body, library, self.n_q + len(self.sliding), starts,
+                                    self.ancf.dofs.element_indices(wire), params))
+
+    def set_window(self, sl: Sliding, s: float) -> bool:
+        """Centre the window of a sliding joint on ``s``; returns True if it moved."""
+        n_el = len(sl.element_start) - 1
+        size = min(self.window_size, n_el)
+        k = int(np.clip(np.searchsorted(sl.element_start, s, side="right") - 1, 0, n_el - 1))
+        first = int(np.clip(k - size // 2, 0, n_el - size))
+        new = (first, first + size)
+        moved = new != sl.window
+        sl.window = new
+        return moved
+
+    def window_margin(self, s: np.ndarray) -> float:
+        """Smallest distance, in elements, from any sliding point to the edge of its window
+        (a wire end counts as no edge)."""
+        margin = np.inf
+        for sl, s_k in zip(self.sliding, s):
+            lo, hi = sl.window
+            n_el = len(sl.element_start) - 1
+            length = sl.element_start[1] - sl.element_start[0]
+            if lo > 0:
+                margin = min(margin, (s_k - sl.element_start[lo]) / length)
+            if hi < n_el:
+                margin = min(margin, (sl.element_start[hi] - s_k) / length)
+        return margin
+
+    def _add_force(self, force):
+        if isinstance(force, PointLoad):
+            body = self.scene.find(force.body)
+            side = self.side(force.body, body.position if force.at is None else force.at)
+            values = {f"ui_{k}": side.local["u"][k] for k in range(3)}
+            for key, vec in (("F0", force.force), ("F1", force.force_amplitude), ("T0", force.torque), ("T1", force.torque_amplitude)):
+                values.update({f"{key}_{k}": float(vec[k]) for k in range(3)})
+            values.update(omega=2 * np.pi * force.frequency, phase=force.phase)
+            self._add("pointload_rigid", force.name, [side], values, self.force_groups)
+            return
+        if isinstance(force, SpringDamper):
+            a, b = self.side(force.body_i, force.at_i), self.side(force.body_j, force.at_j)
+            if a.kind == "ground":
+                a, b = b, a
+            if a.kind == "node" and b.kind == "rigid":
+                a, b = b, a
+            library = f"springdamper_{a.kind}_{b.kind}"
+            if a.kind == "rigid" and b.kind == "node":
+                library = "springdamper_node_rigid"
+                a, b = b, a
+            length0 = float(np.linalg.norm(np.asarray(force.at_j, float) - np.asarray(force.at_i, float)))
+            values = {f"ui_{k}": a.local["u"][k] for k in range(3)}
+            values.update({f"uj_{k}": b.local["u"][k] for k in range(3)})
+            values.update(l0=length0 if force.free_length is None else force.free_length, k=force.stiffness,
+                          k3=force.cubic_stiffness, c=force.damping, tension_only=float(force.tension_only))
+            self._add(library, force.name, [a, b], values, self.force_groups)
+            return
+        if isinstance(force, RotationalSpring):
+            a = self.side(force.body_i, self.scene.find(force.body_i).position)
+            b = self.side(force.body_j, a.body.position)
+            x, _ = perpendiculars(force.axis)
+            values = {}
+            self._vectors(values, a, "i", z=unit(force.axis), x=x)
+            self._vectors(values, b, "j", x=x)
+            values.update(phi0=force.angle0, k=force.stiffness, c=force.damping)
+            self._add(f"rotspring_{a.kind}_{b.kind}", force.name, [a, b], values, self.force_groups)
+            return
+        raise ParameterError(f"unsupported force element {type(force).__name__}")
+
+    def _group_rows(self):
+        """Constraint row numbering: groups in order, then sliding joints (3 rows each)."""
+        self.row_start = {}
+        n = 0
+        for lib, g in self.groups.items():
+            n_c = library_interface(lib)["n_c"]
+            self.row_start[lib] = n
+            for name in g.names:
+                self.row_names += [f"{name}[{k}]" for k in range(n_c)]
+            n += n_c * len(g.names)
+        self.sliding_row_start = n
+        for sl in self.sliding:
+            self.row_names += [f"{sl.joint.name}[{k}]" for k in range(3)]
+            n += 3
+        self.n_c = n
+        # Tangency rows (the first row of each sliding joint) are eliminated in the embedded form.
+        self.tangency_rows = [self.sliding_row_start + 3 * k for k in range(self.n_s)]
+
+    def coordinate_names(self) -> list[str]:
+        names = self.ancf.dofs.names()
+        for b in self.scene.rigid_bodies:
+            names += [f"{b.name}.{c}" for c in ("x", "y", "z", "e0", "e1", "e2", "e3")]
+        return names
+
+    # --- MX builders --------------------------------------------------------------------------
+    def mass_matrix(self, q: ca.MX) -> ca.MX:
+        m = ca.MX(to_casadi_sparse(sps.block_diag([self.ancf.mass_matrix, sps.csc_matrix((self.n_q - self.ancf.n,) * 2)], format="csc")))
+        if self.scene.rigid_bodies:
+            idx = np.array([self._rigid_indices(b.name) for b in self.scene.rigid_bodies])
+            p = ca.DM(np.array([b.params for b in self.scene.rigid_bodies]).T)
+            lib = kernel_library("rigid")
+            blocks = lib["rigid_mass"].map(len(idx))(_gather(q, idx), p)
+            m += MatrixScatter.square(idx, self.n_q, lib["rigid_mass"].sparsity_out(0))(blocks)
+        return m
+
+    def forces(self, q: ca.MX, v: ca.MX, t: ca.MX, ancf_force: ca.Function | None = None) -> ca.MX:
+        """All applied, internal and quadratic-velocity forces (N, N m)."""
+        n_a = self.ancf.n
+        f = ca.MX(self.n_q, 1)
+        if n_a:
+            qa, va = q[:n_a], v[:n_a]
+            internal = ancf_force(qa, va) if ancf_force is not None else self.ancf.internal_force(qa, va)
+            f += ca.vertcat(internal + self.ancf.external_force(qa), ca.MX(self.n_q - n_a, 1))
+        if self.scene.rigid_bodies:
+            bodies = self.scene.rigid_bodies
+            idx = np.array([self._rigid_indices(b.name) for b in bodies])
+            p = ca.DM(np.array([b.params for b in bodies]).T)
+            qv = kernel_library("rigid")["rigid_qv"].map(len(bodies))(_gather(q, idx), _gather(v, idx), p)
+            f += ca.mtimes(vector_scatter(idx, self.n_q), ca.vec(qv))
+            g = self.scene.gravity_vector()
+            weight = np.zeros(self.n_q)
+            for b, rows in zip(bodies, idx):
+                weight[rows[:3]] += b.mass * g
+            f += ca.DM(weight)
+        for lib, group in self.force_groups.items():
+            rows = np.array(group.rows)
+            fn = kernel_library(lib)[lib].map(len(rows))
+            out = fn(_gather(q, rows), _gather(v, rows), t, ca.DM(np.array(group.params).T))
+            f += ca.mtimes(vector_scatter(rows, self.n_q), ca.vec(out))
+        return f
+
+    def _sliding_local(self, sl: Sliding, q: ca.MX, v: ca.MX, s: ca.MX, s_dot: ca.MX):
+        """Selected element's coordinates, rates, s - S_k and element length (masked window)."""
+        lo, hi = sl.window
+        e = ca.MX.zeros(sl.element_indices.shape[1], 1)
+        e_dot = ca.MX.zeros(sl.element_indices.shape[1], 1)
+        start = ca.MX(0)
+        length = ca.MX(0)
+        n_el = len(sl.element_start) - 1
+        for k in range(lo, hi):
+            below = s >= sl.element_start[k] if k > lo else ca.MX(1)
+            above = s < sl.element_start[k + 1] if k < hi - 1 else ca.MX(1)
+            mask = ca.logic_and(below, above)
+            idx = sl.element_indices[k].tolist()
+            e += ca.if_else(mask, q[idx], 0)
+            e_dot += ca.if_else(mask, v[idx], 0)
+            start += ca.if_else(mask, sl.element_start[k], 0)
+            length += ca.if_else(mask, sl.element_start[k + 1] - sl.element_start[k], 0)
+        del n_el
+        rows = self._rigid_indices(sl.body.name)
+        y = ca.vertcat(e, q[rows], s - start)
+        y_dot = ca.vertcat(e_dot, v[rows], s_dot)
+        return y, y_dot, length
+
+    def constraints(self, q: ca.MX, v: ca.MX, s: ca.MX, s_dot: ca.MX, t: ca.MX) -> dict:
+        """Constraint values ``c``, Jacobians ``c_q`` (sparse), ``c_s``, ``c_t`` and ``q_d``."""
+        c_parts, cq_parts, cs_parts, ct_parts, qd_parts = [], [], [], [], []
+        for lib, group in self.groups.items():
+            rows = np.array(group.rows)
+            m = len(rows)
+            p = ca.DM(np.array(group.params).T)
+            kl = kernel_library(lib)
+            y = _gather(q, rows)
+            y_dot = _gather(v, rows)
+            n_c = library_interface(lib)["n_c"]
+            c_parts.append(ca.vec(kl[f"{lib}_c"].map(m)(y, t, p)))
+            c_y, c_t = kl[f"{lib}_jac"].map(m)(y, t, p)
+            local_rows = np.arange(m * n_c).reshape(m, n_c)
+            scatter = MatrixScatter(local_rows, rows, (m * n_c, self.n_q), kl[f"{lib}_jac"].sparsity_out(0))
+            cq_parts.append(scatter(c_y))
+            cs_parts.append(ca.MX(m * n_c, self.n_s))
+            ct_parts.append(ca.vec(c_t))
+            qd_parts.append(ca.vec(kl[f"{lib}_gamma"].map(m)(y, y_dot, t, p)))
+        for k, sl in enumerate(self.sliding):
+            kl = kernel_library(sl.library)
+            y, y_dot, length = self._sliding_local(sl, q, v, s[k], s_dot[k])
+            p = ca.vertcat(length, ca.DM(sl.params[1:]))
+            c_parts.append(kl[f"{sl.library}_c"](y, t, p))
+            c_y, c_t = kl[f"{sl.library}_jac"](y, t, p)
+            n_loc = sl.element_indices.shape[1]
+            # Chain rule through the masked selection: d e / d q = sum_k mask_k P_k.
+            lo, hi = sl.window
+            cq = ca.MX(3, self.n_q)
+            for kk in range(lo, hi):
+                below = s[k] >= sl.element_start[kk] if kk > lo else ca.MX(1)
+                above = s[k] < sl.element_start[kk + 1] if kk < hi - 1 else ca.MX(1)
+                mask = ca.logic_and(below, above)
+                cq += _place(ca.if_else(mask, c_y[:, :n_loc], 0), sl.element_indices[kk], self.n_q)
+            cq += _place(c_y[:, n_loc : n_loc + 7], self._rigid_indices(sl.body.name), self.n_q)
+            cq_parts.append(cq)
+            cs = ca.MX(3, self.n_s)
+            cs[:, k] = c_y[:, n_loc + 7]
+            cs_parts.append(cs)
+            ct_parts.append(c_t)
+            qd_parts.append(kl[f"{sl.library}_gamma"](y, y_dot, t, p))
+        if not c_parts:
+            z = ca.MX(0, 1)
+            return {"c": z, "c_q": ca.MX(0, self.n_q), "c_s": ca.MX(0, self.n_s), "c_t": z, "q_d": z}
+        return {"c": ca.vertcat(*c_parts), "c_q": ca.vertcat(*cq_parts), "c_s": ca.vertcat(*cs_parts),
+                "c_t": ca.vertcat(*ct_parts), "q_d": ca.vertcat(*qd_parts)}
+
+    def kinetic_energy(self, q: ca.MX, v: ca.MX) -> ca.MX:
+        return 0.5 * ca.dot(v, ca.mtimes(self.mass_matrix(q), v))
+
+    def potential_energy(self, q: ca.MX) -> ca.MX:
+        """Strain energy plus the potential of gravity and of constant loads (J)."""
+        u = ca.MX(0)
+        n_a = self.ancf.n
+        if n_a:
+            qa = q[:n_a]
+            for es in self.ancf.element_sets:
+                u += es.energy(qa)
+            u -= ca.dot(self.ancf.constant_load(), qa)
+        g = self.scene.gravity_vector()
+        for b in self.scene.rigid_bodies:
+            r = q[self._rigid_indices(b.name)[:3]]
+            u -= b.mass * ca.dot(ca.DM(g), r)
+        return u
+
+
+def _gather(x: ca.MX, rows: np.ndarray) -> ca.MX:
+    rows = np.asarray(rows)
+    return ca.reshape(x[rows.ravel().tolist()], rows.shape[1], rows.shape[0])
+
+
+def _place(block: ca.MX, cols, n: int) -> ca.MX:
+    """Put the columns of ``block`` at global columns ``cols`` of an (rows x n) matrix."""
+    cols = list(cols)
+    p = sps.csc_matrix((np.ones(len(cols)), (np.arange(len(cols)), cols)), shape=(len(cols), n))
+    return ca.mtimes(block, ca.MX(to_casadi_sparse(p)))
+
+
+def _available() -> set[str]:
+    from ..codegen.paths import read_manifest
+
+    return set(read_manifest()["libraries"])

@@ -1,0 +1,183 @@
+"""Semi-explicit DAEs for IDAS from an assembled :class:`MultibodyModel`.
+
+Notation: ``q`` free generalized coordinates (fixed ANCF coordinates are eliminated), ``v`` their
+velocities, ``s`` the arc-length parameters, ``M a + C_q^T lambda = Q`` the dynamics.
+
+augmented, index 1 (seed eq. 25)
+    x = [q, s, v, w], z = [a, s_dd, lambda];  q' = v, s' = w, v' = a, w' = s_dd;
+    0 = M a + C_q^T lambda - Q,  0 = C_s^T lambda,
+    0 = C_q a + C_s s_dd + Q_d + 2 alpha C_dot + beta^2 C   (Baumgarte).
+augmented, GGL (stabilized index 2)
+    x = [q, s, v], z = [a, w, lambda, mu];  q' = v + C_q^T mu, s' = w + C_s^T mu, v' = a;
+    0 = M a + C_q^T lambda - Q,  0 = C_s^T lambda,  0 = C,  0 = C_q v + C_s w + C_t.
+embedded, index 1 (seed eq. 26)
+    The first (tangency) row ``C_T`` of every sliding joint is kept as the algebraic equation
+    that defines ``s(q)`` (``s`` becomes algebraic); the other rows ``C_R`` get the Jacobian
+    ``H = C_Rq - C_Rs C_Ts^-1 C_Tq`` and ``Q_cn = Q_dR - C_Rs C_Ts^-1 Q_dT`` with
+    ``s' = -C_Ts^-1 C_Tq v``: x = [q, v], z = [a, s, lambda_n];
+    0 = M a + H^T lambda_n - Q,  0 = C_T,  0 = H a + Q_cn + 2 alpha C_R' + beta^2 C_R.
+embedded, GGL
+    x = [q, v], z = [a, s, lambda_n, mu];  q' = v + H^T mu;
+    0 = M a + H^T lambda_n - Q,  0 = C_T,  0 = C_R,  0 = H v + C_Rt.
+
+Accelerations and multipliers are algebraic; the driver keeps them out of IDAS's error test.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+import scipy.sparse as sps
+
+from ..assembly.multibody import MultibodyModel
+from ..assembly.sparse import to_casadi_sparse
+from ..errors import ParameterError
+
+FORMULATIONS = ("augmented", "embedded")
+INDICES = ("1", "ggl")
+
+
+@dataclass
+class Block:
+    name: str
+    start: int
+    size: int
+
+    @property
+    def slice(self) -> slice:
+        return slice(self.start, self.start + self.size)
+
+
+class Formulation:
+    """One DAE form of a multibody model.
+
+    Parameters
+    ----------
+    model : MultibodyModel
+    formulation : {"augmented", "embedded"}
+    index : {"1", "ggl"}
+    baumgarte : float
+        Baumgarte parameter (1/s) of the index-1 forms: ``alpha = beta = baumgarte``.
+    """
+
+    def __init__(self, model: MultibodyModel, formulation: str = "augmented", index: str = "1", baumgarte: float = 10.0):
+        if formulation not in FORMULATIONS:
+            raise ParameterError(f"formulation={formulation!r}: must be one of {', '.join(FORMULATIONS)}")
+        if str(index) not in INDICES:
+            raise ParameterError(f"index={index!r}: must be one of {', '.join(INDICES)}")
+        self.model = model
+        self.formulation = formulation
+        self.index = str(index)
+        self.baumgarte = float(baumgarte)
+        n_q = model.n_q
+        self.n_f = len(model.free)
+        p = sps.csc_matrix((np.ones(self.n_f), (model.free, np.arange(self.n_f))), shape=(n_q, self.n_f))
+        self.P = ca.DM(to_casadi_sparse(p))
+        q_fixed = model.q0.copy()
+        q_fixed[model.free] = 0.0
+        self.q_fixed = ca.DM(q_fixed)
+        self.n_s, self.n_c = model.n_s, model.n_c
+        tang = model.tangency_rows
+        self.rows_t = tang
+        self.rows_r = [r for r in range(self.n_c) if r not in set(tang)]
+
+    # --- shared pieces ------------------------------------------------------------------------
+    def terms(self, q_f, v_f, s, w, t):
+        """Mass matrix, forces and constraint terms in free coordinates (MX)."""
+        m = self.model
+        q = self.q_fixed + ca.mtimes(self.P, q_f)
+        v = ca.mtimes(self.P, v_f)
+        c = m.constraints(q, v, s, w, t)
+        mass = ca.mtimes(self.P.T, ca.mtimes(m.mass_matrix(q), self.P))
+        force = ca.mtimes(self.P.T, m.forces(q, v, t))
+        return {"q": q, "v": v, "M": mass, "Q": force, "C": c["c"], "Cq": ca.mtimes(c["c_q"], self.P),
+                "Cs": c["c_s"], "Ct": c["c_t"], "Qd": c["q_d"]}
+
+    def embedded_terms(self, q_f, v_f, s, t):
+        """``s_dot`` from the tangency rows, then ``H``, ``Q_cn`` and the reduced constraint terms."""
+        probe = self.terms(q_f, v_f, s, ca.MX.zeros(self.n_s), t)
+        tr, rr = self.rows_t, self.rows_r
+        c_ts = ca.diag(probe["Cs"][tr, :])           # one s per tangency row
+        s_dot = -ca.mtimes(probe["Cq"][tr, :], v_f) / c_ts
+        k = self.terms(q_f, v_f, s, s_dot, t)
+        c_rs = k["Cs"][rr, :]
+        inv = 1 / ca.diag(k["Cs"][tr, :])
+        h = k["Cq"][rr, :] - ca.mtimes(c_rs, ca.mtimes(ca.diag(inv), k["Cq"][tr, :]))
+        q_cn = k["Qd"][rr] - ca.mtimes(c_rs, inv * k["Qd"][tr])
+        c_dot_r = ca.mtimes(h, v_f) + k["Ct"][rr]
+        return {**k, "H": h, "Qcn": q_cn, "s_dot": s_dot, "CR": k["C"][rr], "CT": k["C"][tr], "CRdot": c_dot_r}
+
+    # --- the DAE ------------------------------------------------------------------------------
+    def blocks(self):
+        n_f, n_s, n_c = self.n_f, self.n_s, self.n_c
+        n_r = n_c - n_s
+        if self.formulation == "augmented":
+            x = [("q", n_f), ("s", n_s), ("v", n_f)] + ([("w", n_s)] if self.index == "1" else [])
+            z = [("a", n_f)] + ([("s_dd", n_s)] if self.index == "1" else [("w", n_s)]) + [("lambda", n_c)]
+            z += [("mu", n_c)] if self.index == "ggl" else []
+        else:
+            x = [("q", n_f), ("v", n_f)]
+            z = [("a", n_f), ("s", n_s), ("lambda", n_r)] + ([("mu", n_r)] if self.index == "ggl" else [])
+        return _layout(x), _layout(z)
+
+    def dae(self) -> dict:
+        """CasADi DAE dict ``{x, z, p, t, ode, alg}``; ``p`` is the time offset of the chunk."""
+        xb, zb = self.blocks()
+        x = ca.MX.sym("x", sum(b.size for b in xb.values()))
+        z = ca.MX.sym("z", sum(b.size for b in zb.values()))
+        t_rel = ca.MX.sym("t")
+        t0 = ca.MX.sym("t0")
+        t = t0 + t_rel
+        X = {k: x[b.slice] for k, b in xb.items()}
+        Z = {k: z[b.slice] for k, b in zb.items()}
+        al = be = self.baumgarte
+        if self.formulation == "augmented":
+            w = X["w"] if self.index == "1" else Z["w"]
+            k = self.terms(X["q"], X["v"], X["s"], w, t)
+            dyn = ca.mtimes(k["M"], Z["a"]) + ca.mtimes(k["Cq"].T, Z["lambda"]) - k["Q"]
+            free_s = ca.mtimes(k["Cs"].T, Z["lambda"])
+            c_dot = ca.mtimes(k["Cq"], X["v"]) + ca.mtimes(k["Cs"], w) + k["Ct"]
+            if self.index == "1":
+                acc = ca.mtimes(k["Cq"], Z["a"]) + ca.mtimes(k["Cs"], Z["s_dd"]) + k["Qd"] + 2 * al * c_dot + be**2 * k["C"]
+                ode = ca.vertcat(X["v"], w, Z["a"], Z["s_dd"])
+                alg = ca.vertcat(dyn, free_s, acc)
+            else:
+                ode = ca.vertcat(X["v"] + ca.mtimes(k["Cq"].T, Z["mu"]), w + ca.mtimes(k["Cs"].T, Z["mu"]), Z["a"])
+                alg = ca.vertcat(dyn, free_s, k["C"], c_dot)
+        else:
+            k = self.embedded_terms(X["q"], X["v"], Z["s"], t)
+            dyn = ca.mtimes(k["M"], Z["a"]) + ca.mtimes(k["H"].T, Z["lambda"]) - k["Q"]
+            if self.index == "1":
+                acc = ca.mtimes(k["H"], Z["a"]) + k["Qcn"] + 2 * al * k["CRdot"] + be**2 * k["CR"]
+                ode = ca.vertcat(X["v"], Z["a"])
+                alg = ca.vertcat(dyn, k["CT"], acc)
+            else:
+                ode = ca.vertcat(X["v"] + ca.mtimes(k["H"].T, Z["mu"]), Z["a"])
+                alg = ca.vertcat(dyn, k["CT"], k["CR"], k["CRdot"])
+        return {"x": x, "z": z, "p": t0, "t": t_rel, "ode": ode, "alg": alg}
+
+    def residual_names(self) -> list[str]:
+        """Names of the algebraic residual rows (for failure reports)."""
+        coords = [self.model.coordinate_names()[i] for i in self.model.free]
+        rows = self.model.row_names
+        sliding = [sl.joint.name for sl in self.model.sliding]
+        dyn = [f"dynamics of {c}" for c in coords]
+        if self.formulation == "augmented":
+            names = dyn + [f"C_s^T lambda of {n}" for n in sliding]
+            if self.index == "1":
+                return names + [f"acceleration constraint {r}" for r in rows]
+            return names + [f"position constraint {r}" for r in rows] + [f"velocity constraint {r}" for r in rows]
+        kept = [rows[r] for r in self.rows_r]
+        names = dyn + [f"tangency of {n}" for n in sliding]
+        if self.index == "1":
+            return names + [f"acceleration constraint {r}" for r in kept]
+        return names + [f"position constraint {r}" for r in kept] + [f"velocity constraint {r}" for r in kept]
+
+
+def _layout(entries) -> dict[str, Block]:
+    out, start = {}, 0
+    for name, size in entries:
+        out[name] = Block(name, start, size)
+        start += size
+    return out

@@ -1,0 +1,128 @@
+"""Consistent initial conditions by projection (not IDAS's own initial-condition solver).
+
+Positions and arc lengths are projected onto ``C = 0`` by minimum-norm Gauss-Newton steps,
+velocities onto ``C_q v + C_s w + C_t = 0`` by one minimum-norm correction, and the
+accelerations and multipliers solve the linear KKT system of the chosen formulation.
+"""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
+
+from ..assembly.sparse import to_scipy
+from ..errors import SolverError
+from .formulation import Formulation
+
+
+def _terms_function(form: Formulation) -> ca.Function:
+    n_f, n_s = form.n_f, form.n_s
+    q, v, s, w, t = ca.MX.sym("q", n_f), ca.MX.sym("v", n_f), ca.MX.sym("s", n_s), ca.MX.sym("w", n_s), ca.MX.sym("t")
+    k = form.terms(q, v, s, w, t)
+    names = ["C", "Cq", "Cs", "Ct", "Qd", "M", "Q"]
+    return ca.Function("terms", [q, v, s, w, t], [k[n] for n in names], ["q", "v", "s", "w", "t"], names)
+
+
+def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max_iterations: int = 30):
+    """Consistent ``(x0, z0)`` for ``form`` at time ``t0`` from the scene's initial state.
+
+    Raises
+    ------
+    SolverError
+        Naming the joints involved when the constraints are redundant or cannot be satisfied.
+    """
+    model = form.model
+    fn = _terms_function(form)
+    q = model.q0[model.free].copy()
+    v = model.v0[model.free].copy()
+    s = model.s0.copy()
+    w = np.zeros(form.n_s)
+    names = model.row_names
+    n_f = form.n_f
+
+    def evaluate(q, v, s, w):
+        out = fn(q, v, s, w, t0)
+        c, cq, cs, ct, qd, m, f = out
+        return (np.asarray(c).ravel(), sps.hstack([to_scipy(cq), to_scipy(ca.DM(cs))]).tocsc(),
+                np.asarray(ct).ravel(), np.asarray(qd).ravel(), to_scipy(m), np.asarray(f).ravel(),
+                to_scipy(ca.DM(cq)), np.asarray(ca.densify(cs)))
+
+    if form.n_c:
+        c, jac, *_ = evaluate(q, v, s, w)
+        _check_rank(jac, names)
+        scale = 1.0 + np.abs(np.r_[q, s]).max(initial=0.0)
+        for _ in range(max_iterations):
+            if np.abs(c).max() <= tol * scale:
+                break
+            u = np.r_[q, s] - jac.T @ _solve(jac @ jac.T, c)
+            q, s = u[:n_f], u[n_f:]
+            c, jac, *_ = evaluate(q, v, s, w)
+        else:
+            worst = int(np.argmax(np.abs(c)))
+            raise SolverError(
+                f"initial conditions cannot be made consistent: after {max_iterations} projections the "
+                f"constraint {names[worst]} is still violated by {c[worst]:.3g}; check the joint positions"
+            )
+        c, jac, ct, *_ = evaluate(q, v, s, w)
+        u_dot = np.r_[v, w]
+        u_dot -= jac.T @ _solve(jac @ jac.T, jac @ u_dot + ct)
+        v, w = u_dot[:n_f], u_dot[n_f:]
+    c, jac, ct, qd, m, f, cq, cs = evaluate(q, v, s, w)
+    xb, zb = form.blocks()
+    x0 = np.zeros(sum(b.size for b in xb.values()))
+    z0 = np.zeros(sum(b.size for b in zb.values()))
+    if form.formulation == "augmented":
+        kkt = sps.bmat([[m, None, cq.T], [None, sps.csc_matrix((form.n_s, form.n_s)), sps.csc_matrix(cs.T)],
+                        [cq, sps.csc_matrix(cs), None]], format="csc")
+        sol = _solve(kkt, np.r_[f, np.zeros(form.n_s), -qd])
+        a, s_dd, lam = sol[:n_f], sol[n_f : n_f + form.n_s], sol[n_f + form.n_s :]
+        values_x = {"q": q, "s": s, "v": v, "w": w}
+        values_z = {"a": a, "s_dd": s_dd, "w": w, "lambda": lam, "mu": np.zeros(form.n_c)}
+    else:
+        tr, rr = form.rows_t, form.rows_r
+        cq_d = cq.toarray() if form.n_s else cq
+        if form.n_s:
+            inv = 1 / np.array([cs[r, k] for k, r in enumerate(tr)])
+            h = sps.csc_matrix(cq_d[rr] - cs[rr] @ (inv[:, None] * cq_d[tr]))
+            q_cn = qd[rr] - cs[rr] @ (inv * qd[tr])
+        else:
+            h, q_cn = cq, qd
+        kkt = sps.bmat([[m, h.T], [h, None]], format="csc")
+        sol = _solve(kkt, np.r_[f, -q_cn])
+        values_x = {"q": q, "v": v}
+        values_z = {"a": sol[:n_f], "s": s, "lambda": sol[n_f:], "mu": np.zeros(len(rr))}
+    for name, b in xb.items():
+        x0[b.slice] = values_x[name]
+    for name, b in zb.items():
+        z0[b.slice] = values_z[name]
+    return x0, z0
+
+
+def _solve(a: sps.spmatrix, b: np.ndarray) -> np.ndarray:
+    if a.shape[0] == 0:
+        return np.zeros(0)
+    with np.errstate(all="ignore"):
+        x = spla.spsolve(sps.csc_matrix(a), b)
+    if not np.all(np.isfinite(x)):
+        raise SolverError("singular system while making the initial conditions consistent (redundant constraints?)")
+    return np.atleast_1d(x)
+
+
+def _check_rank(jac: sps.spmatrix, names: list[str]) -> None:
+    """Raise naming the constraints that are redundant at the initial state."""
+    n_c = jac.shape[0]
+    if n_c == 0 or n_c > 3000:
+        return
+    dense = jac.toarray()
+    _, r, piv = sla.qr(dense.T, pivoting=True, mode="economic")
+    diag = np.abs(np.diag(r))
+    tol = max(dense.shape) * np.finfo(float).eps * (diag[0] if diag.size else 1.0) * 1e3
+    rank = int(np.sum(diag > tol))
+    if rank < n_c:
+        dependent = sorted({names[i].split("[")[0] for i in piv[rank:]})
+        raise SolverError(
+            f"redundant or inconsistent constraints at the initial state: the Jacobian has rank {rank} "
+            f"for {n_c} equations; look at {', '.join(dependent)} (a joint that repeats what others impose)"
+        )

@@ -1,0 +1,4 @@
+"""Time integration with CasADi's IDAS."""
+from .simulate import SimulationResult, simulate
+
+__all__ = ["SimulationResult", "simulate"]
