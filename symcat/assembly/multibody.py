@@ -300,14 +300,12 @@ class MultibodyModel:
             m += MatrixScatter.square(idx, self.n_q, lib["rigid_mass"].sparsity_out(0))(blocks)
         return m
 
-    def forces(self, q: ca.MX, v: ca.MX, t: ca.MX, ancf_force: ca.Function | None = None) -> ca.MX:
+    def forces(self, q: ca.MX, v: ca.MX, t: ca.MX) -> ca.MX:
         """All applied, internal and quadratic-velocity forces (N, N m)."""
         n_a = self.ancf.n
         f = ca.MX(self.n_q, 1)
         if n_a:
-            qa, va = q[:n_a], v[:n_a]
-            internal = ancf_force(qa, va) if ancf_force is not None else self.ancf.internal_force(qa, va)
-            f += ca.vertcat(internal + self.ancf.external_force(qa), ca.MX(self.n_q - n_a, 1))
+            f += ca.vertcat(self.ancf.force_function()(q[:n_a], v[:n_a]), ca.MX(self.n_q - n_a, 1))
         if self.scene.rigid_bodies:
             bodies = self.scene.rigid_bodies
             idx = np.array([self._rigid_indices(b.name) for b in bodies])
@@ -326,28 +324,36 @@ class MultibodyModel:
             f += ca.mtimes(vector_scatter(rows, self.n_q), ca.vec(out))
         return f
 
-    def _sliding_local(self, sl: Sliding, q: ca.MX, v: ca.MX, s: ca.MX, s_dot: ca.MX):
-        """Selected element's coordinates, rates, s - S_k and element length (masked window)."""
+    def _selection(self, sl: Sliding, s: ca.MX):
+        """Sparse ``Sel(s)`` with ``e = Sel q`` the coordinates of the element containing ``s``
+        (within the window), and that element's start and length. The masks are piecewise
+        constant in ``s`` (zero derivative), so one sparse product carries the chain rule."""
         lo, hi = sl.window
-        e = ca.MX.zeros(sl.element_indices.shape[1], 1)
-        e_dot = ca.MX.zeros(sl.element_indices.shape[1], 1)
-        start = ca.MX(0)
-        length = ca.MX(0)
-        n_el = len(sl.element_start) - 1
+        masks = []
         for k in range(lo, hi):
             below = s >= sl.element_start[k] if k > lo else ca.MX(1)
             above = s < sl.element_start[k + 1] if k < hi - 1 else ca.MX(1)
-            mask = ca.logic_and(below, above)
-            idx = sl.element_indices[k].tolist()
-            e += ca.if_else(mask, q[idx], 0)
-            e_dot += ca.if_else(mask, v[idx], 0)
-            start += ca.if_else(mask, sl.element_start[k], 0)
-            length += ca.if_else(mask, sl.element_start[k + 1] - sl.element_start[k], 0)
-        del n_el
+            masks.append(ca.logic_and(below, above))
+        masks = ca.vertcat(*masks)
+        n_loc = sl.element_indices.shape[1]
+        rows = np.tile(np.arange(n_loc), hi - lo)
+        cols = sl.element_indices[lo:hi].ravel()
+        order = np.lexsort((rows, cols))  # CSC order: by column, then row
+        pattern = ca.Sparsity.triplet(n_loc, self.n_q, rows[order].tolist(), cols[order].tolist())
+        values = ca.repmat(masks.T, n_loc, 1)  # entry (r, k): mask of window element k
+        values = ca.vec(values)[order.tolist()]
+        sel = ca.sparsity_cast(values, pattern)
+        start = ca.dot(masks, ca.DM(sl.element_start[lo:hi]))
+        length = ca.dot(masks, ca.DM(np.diff(sl.element_start)[lo:hi]))
+        return sel, start, length
+
+    def _sliding_local(self, sl: Sliding, q: ca.MX, v: ca.MX, s: ca.MX, s_dot: ca.MX):
+        """Selected element's coordinates, rates, s - S_k and element length (see _selection)."""
+        sel, start, length = self._selection(sl, s)
         rows = self._rigid_indices(sl.body.name)
-        y = ca.vertcat(e, q[rows], s - start)
-        y_dot = ca.vertcat(e_dot, v[rows], s_dot)
-        return y, y_dot, length
+        y = ca.vertcat(ca.mtimes(sel, q), q[rows], s - start)
+        y_dot = ca.vertcat(ca.mtimes(sel, v), v[rows], s_dot)
+        return y, y_dot, length, sel
 
     def constraints(self, q: ca.MX, v: ca.MX, s: ca.MX, s_dot: ca.MX, t: ca.MX) -> dict:
         """Constraint values ``c``, Jacobians ``c_q`` (sparse), ``c_s``, ``c_t`` and ``q_d``."""
@@ -370,20 +376,12 @@ class MultibodyModel:
             qd_parts.append(ca.vec(kl[f"{lib}_gamma"].map(m)(y, y_dot, t, p)))
         for k, sl in enumerate(self.sliding):
             kl = kernel_library(sl.library)
-            y, y_dot, length = self._sliding_local(sl, q, v, s[k], s_dot[k])
+            y, y_dot, length, sel = self._sliding_local(sl, q, v, s[k], s_dot[k])
             p = ca.vertcat(length, ca.DM(sl.params[1:]))
             c_parts.append(kl[f"{sl.library}_c"](y, t, p))
             c_y, c_t = kl[f"{sl.library}_jac"](y, t, p)
             n_loc = sl.element_indices.shape[1]
-            # Chain rule through the masked selection: d e / d q = sum_k mask_k P_k.
-            lo, hi = sl.window
-            cq = ca.MX(3, self.n_q)
-            for kk in range(lo, hi):
-                below = s[k] >= sl.element_start[kk] if kk > lo else ca.MX(1)
-                above = s[k] < sl.element_start[kk + 1] if kk < hi - 1 else ca.MX(1)
-                mask = ca.logic_and(below, above)
-                cq += _place(ca.if_else(mask, c_y[:, :n_loc], 0), sl.element_indices[kk], self.n_q)
-            cq += _place(c_y[:, n_loc : n_loc + 7], self._rigid_indices(sl.body.name), self.n_q)
+            cq = ca.mtimes(c_y[:, :n_loc], sel) + _place(c_y[:, n_loc : n_loc + 7], self._rigid_indices(sl.body.name), self.n_q)
             cq_parts.append(cq)
             cs = ca.MX(3, self.n_s)
             cs[:, k] = c_y[:, n_loc + 7]

@@ -96,6 +96,30 @@ class System:
     def constant_load(self) -> ca.DM:
         return ca.DM(self._constant_load)
 
+    def force_function(self) -> ca.Function:
+        """``ancf_forces(q, v) -> f``: internal (elastic, damping) plus external forces, with its
+        Jacobian supplied explicitly (``custom_jacobian``) from the compiled element stiffness
+        and damping kernels scattered into sparse matrices, instead of CasADi's AD through the
+        mapped kernels (about ten times faster on long wires)."""
+        if getattr(self, "_force_fn", None) is not None:
+            return self._force_fn
+        q, v = ca.MX.sym("q", self.n), ca.MX.sym("v", self.n)
+        f = self.internal_force(q, v) + self.external_force(q)
+        d_q = -self.tangent_stiffness(q)
+        d_v = ca.MX(self.n, self.n)
+        for es in self.element_sets:
+            if es.damped:
+                d, c = es.damping_matrices(q, v)
+                d_q -= d
+                d_v -= c
+        if self._moments:
+            d_q += ca.jacobian(self._moment_force(q), q)
+        out = ca.MX.sym("out_f", self.n)
+        jac = ca.Function("jac_ancf_forces", [q, v, out], [d_q, d_v], ["q", "v", "out_f"], ["jac_f_q", "jac_f_v"])
+        self._force_fn = ca.Function("ancf_forces", [q, v], [f], ["q", "v"], ["f"],
+                                     {"custom_jacobian": jac, "jac_penalty": 0})
+        return self._force_fn
+
     # --- compiled numeric functions -------------------------------------------------------
     @cached_property
     def static_functions(self) -> ca.Function:

@@ -94,6 +94,22 @@ class AncfBody:
         params = element_parameters(etype, lengths, material, section, prestrain, damping_axial, damping_bending)
         return cls(name=name, element=etype, q0=q0, params=params)
 
+    @classmethod
+    def from_nodes(cls, name: str, element: str, nodes, lengths, material: Material, section: Section,
+                   prestrain: float = 0.0, damping_axial: float = 0.0, damping_bending: float = 0.0) -> "AncfBody":
+        """Mesh through given nodal coordinates (e.g. a curved wire).
+
+        ``nodes`` is (n_nodes, dofs_per_node) in the element's coordinate order; ``lengths``
+        (m) are the reference (arc) lengths of the elements between consecutive nodes.
+        """
+        etype = element_type(element)
+        nodes = np.array(nodes, dtype=float)
+        if nodes.ndim != 2 or nodes.shape[1] != etype.dofs_per_node or len(nodes) < 2:
+            raise ParameterError(f"nodes: need an (n >= 2, {etype.dofs_per_node}) array for {etype.name}")
+        lengths = np.broadcast_to(np.asarray(lengths, dtype=float), (len(nodes) - 1,))
+        params = element_parameters(etype, lengths, material, section, prestrain, damping_axial, damping_bending)
+        return cls(name=name, element=etype, q0=nodes, params=params)
+
     @property
     def n_nodes(self) -> int:
         return self.q0.shape[0]
