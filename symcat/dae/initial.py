@@ -1,7 +1,8 @@
 """Consistent initial conditions by projection (not IDAS's own initial-condition solver).
 
 Positions and arc lengths are projected onto ``C = 0`` by minimum-norm Gauss-Newton steps,
-velocities onto ``C_q v + C_s w + C_t = 0`` by one minimum-norm correction, and the
+velocities onto ``C_q v + C_s w + C_t = 0`` by one minimum-norm correction (the arc lengths
+and their rates weighted 1e-6 times less, so that they follow the bodies), and the
 accelerations and multipliers solve the linear KKT system of the chosen formulation.
 """
 from __future__ import annotations
@@ -49,6 +50,9 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
                 np.asarray(ct).ravel(), np.asarray(qd).ravel(), to_scipy(m), np.asarray(f).ravel(),
                 to_scipy(ca.DM(cq)), np.asarray(ca.densify(cs)))
 
+    # The arc lengths are not generalized coordinates: they move first (a tiny weight), so a
+    # body keeps its given position and velocity and s follows it.
+    w_inv = sps.diags(np.r_[np.ones(n_f), np.full(form.n_s, 1e6)])
     if form.n_c:
         c, jac, *_ = evaluate(q, v, s, w)
         _check_rank(jac, names)
@@ -56,7 +60,7 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
         for _ in range(max_iterations):
             if np.abs(c).max() <= tol * scale:
                 break
-            u = np.r_[q, s] - jac.T @ _solve(jac @ jac.T, c)
+            u = np.r_[q, s] - w_inv @ (jac.T @ _solve(jac @ w_inv @ jac.T, c))
             q, s = u[:n_f], u[n_f:]
             c, jac, *_ = evaluate(q, v, s, w)
         else:
@@ -67,17 +71,14 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
             )
         c, jac, ct, *_ = evaluate(q, v, s, w)
         u_dot = np.r_[v, w]
-        u_dot -= jac.T @ _solve(jac @ jac.T, jac @ u_dot + ct)
+        u_dot -= w_inv @ (jac.T @ _solve(jac @ w_inv @ jac.T, jac @ u_dot + ct))
         v, w = u_dot[:n_f], u_dot[n_f:]
     c, jac, ct, qd, m, f, cq, cs = evaluate(q, v, s, w)
     xb, zb = form.blocks()
     x0 = np.zeros(sum(b.size for b in xb.values()))
     z0 = np.zeros(sum(b.size for b in zb.values()))
     if form.formulation == "augmented":
-        kkt = sps.bmat([[m, None, cq.T], [None, sps.csc_matrix((form.n_s, form.n_s)), sps.csc_matrix(cs.T)],
-                        [cq, sps.csc_matrix(cs), None]], format="csc")
-        sol = _solve(kkt, np.r_[f, np.zeros(form.n_s), -qd])
-        a, s_dd, lam = sol[:n_f], sol[n_f : n_f + form.n_s], sol[n_f + form.n_s :]
+        a, s_dd, lam = kkt_solve(m, f, cq, cs, qd)
         values_x = {"q": q, "s": s, "v": v, "w": w}
         values_z = {"a": a, "s_dd": s_dd, "w": w, "lambda": lam, "mu": np.zeros(form.n_c)}
     else:
@@ -98,6 +99,16 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     for name, b in zb.items():
         z0[b.slice] = values_z[name]
     return x0, z0
+
+
+def kkt_solve(m, f, cq, cs, qd):
+    """Accelerations, arc-length accelerations and multipliers of the augmented form (eq. 25)
+    for a consistent state: ``[[M, 0, C_q^T], [0, 0, C_s^T], [C_q, C_s, 0]]``."""
+    n_f, n_s = m.shape[0], cs.shape[1]
+    kkt = sps.bmat([[m, None, cq.T], [None, sps.csc_matrix((n_s, n_s)), sps.csc_matrix(cs.T)],
+                    [cq, sps.csc_matrix(cs), None]], format="csc")
+    sol = _solve(kkt, np.r_[f, np.zeros(n_s), -qd])
+    return sol[:n_f], sol[n_f : n_f + n_s], sol[n_f + n_s :]
 
 
 def _solve(a: sps.spmatrix, b: np.ndarray) -> np.ndarray:

@@ -16,7 +16,8 @@ import numpy as np
 
 from ..assembly.multibody import MultibodyModel
 from ..dae.formulation import Formulation
-from ..dae.initial import consistent_state
+from ..assembly.sparse import to_scipy
+from ..dae.initial import consistent_state, kkt_solve
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
 
@@ -35,8 +36,9 @@ class SimulationResult:
     s_m, s_dot_m_s : ndarray (n_t, n_s)
         Arc-length parameters of the sliding joints and their rates.
     multipliers : ndarray (n_t, n_c)
-        Lagrange multipliers of every constraint row (``row_names``); for the embedded form
-        the eliminated tangency rows hold 0 (their multiplier is 0 by ``C_s^T lambda = 0``).
+        Lagrange multipliers of every constraint row (``row_names``), recomputed at each output
+        from the KKT system of eq. (25) for the integrated state, so they are exact for that
+        state and identical in meaning for every formulation.
     reactions_N : dict
         Joint name -> (n_t, 3) constraint force on body j (global, N).
     energy_J : dict
@@ -197,6 +199,19 @@ def _failure(form, exc, t, x, z) -> SolverError:
 
 def _result(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
     model = form.model
+    # Post-processing sees the whole wire: the integration windows have moved on.
+    saved = [sl.window for sl in model.sliding]
+    for sl in model.sliding:
+        sl.window = (0, len(sl.element_start) - 1)
+    try:
+        return _collect(form, t, xs, zs, stats, wall0)
+    finally:
+        for sl, w in zip(model.sliding, saved):
+            sl.window = w
+
+
+def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
+    model = form.model
     n_f, n_s = form.n_f, form.n_s
     parts = [_split(form, x, z) for x, z in zip(xs, zs)]
     q = np.tile(model.q0, (len(parts), 1))
@@ -216,25 +231,23 @@ def _result(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
     qf = form.q_fixed + ca.mtimes(form.P, qs)
     vf = ca.mtimes(form.P, vs)
     energy = ca.Function("e", [qs, vs], [model.kinetic_energy(qf, vf), model.potential_energy(qf)])
-    drift = ca.Function("d", [qs, vs, ss, ws, ts], [kk["C"], ca.mtimes(kk["Cq"], vs) + ca.mtimes(kk["Cs"], s_dot_expr) + kk["Ct"], s_dot_expr, kk["Cq"], kk["Cs"]])
+    drift = ca.Function("d", [qs, vs, ss, ws, ts], [kk["C"], ca.mtimes(kk["Cq"], vs) + ca.mtimes(kk["Cs"], s_dot_expr) + kk["Ct"],
+                                                   s_dot_expr, kk["Cq"], kk["Cs"], kk["M"], kk["Q"], kk["Qd"]])
     lam = np.zeros((len(parts), model.n_c))
     s_dot = np.zeros((len(parts), n_s))
     pos, vel, kin, pot = (np.zeros(len(parts)) for _ in range(4))
     reactions = {name.split("[")[0]: np.zeros((len(parts), 3)) for name in model.row_names}
     for i, (p, ti) in enumerate(zip(parts, t)):
         w = p.get("w", np.zeros(n_s))
-        c, cdot, sd, cq, cs = drift(p["q"], p["v"], p["s"], w, ti)
+        c, cdot, sd, cq, cs, mass, force, qd = drift(p["q"], p["v"], p["s"], w, ti)
         s_dot[i] = np.asarray(sd).ravel()
         pos[i] = np.abs(np.asarray(c)).max(initial=0.0)
         vel[i] = np.abs(np.asarray(cdot)).max(initial=0.0)
-        if form.formulation == "augmented":
-            lam[i] = p["lambda"]
-        else:
-            lam[i, form.rows_r] = p["lambda"]
-            if n_s:  # the tangency multipliers follow from C_s^T lambda = 0 (as in the augmented form)
-                cs_d = np.asarray(ca.densify(cs))
-                c_ts = np.array([cs_d[r, k] for k, r in enumerate(form.rows_t)])
-                lam[i, form.rows_t] = -(cs_d[form.rows_r].T @ p["lambda"]) / c_ts
+        # Multipliers from the KKT system at each output (exact for the state, whatever IDAS's
+        # tolerance on algebraic variables): the same for every formulation.
+        if model.n_c:
+            _, _, lam[i] = kkt_solve(to_scipy(mass), np.asarray(force).ravel(), to_scipy(cq),
+                                     np.asarray(ca.densify(cs)), np.asarray(qd).ravel())
         e_k, e_p = energy(p["q"], p["v"])
         kin[i], pot[i] = float(e_k), float(e_p)
         _reactions(model, form, np.asarray(ca.densify(cq)), lam[i], reactions, i)
