@@ -81,7 +81,7 @@ class SimulationResult:
 def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented", index: str = "1",
              rtol: float = 1e-6, atol: float = 1e-8, n_out: int = 200, baumgarte: float = 10.0,
              chunks: int | None = None, max_step: float | None = None, progress: bool = True,
-             algebraic_atol: float = 1e-3) -> SimulationResult:
+             algebraic_atol: float = 1e-3, max_steps: int = 500000) -> SimulationResult:
     """Simulate ``model`` from 0 to ``t_end`` seconds.
 
     Parameters
@@ -104,6 +104,8 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     algebraic_atol : float
         Absolute tolerance of the algebraic variables in IDAS's Newton test (they are not
         error-controlled).
+    max_steps : int
+        IDAS steps allowed per chunk.
     """
     if not t_end > 0:
         raise ParameterError(f"t_end={t_end}: must be > 0 s")
@@ -120,7 +122,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     # atol, GGL's mu (identically ~0) can never "converge" and IDAS reports IDA_CONV_FAIL.
     n_x, n_z = len(x), len(z)
     opts = {"reltol": rtol, "abstolv": [atol] * n_x + [algebraic_atol] * n_z, "suppress_algebraic": True,
-            "calc_ic": False, "max_num_steps": 500000}
+            "calc_ic": False, "max_num_steps": int(max_steps)}
     if max_step:
         opts["max_step_size"] = max_step
     xs, zs = [x], [z]
@@ -144,7 +146,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             try:
                 out = integ(x0=x, z0=z, p=t_grid[a])
             except RuntimeError as exc:
-                raise _failure(form, exc, t_grid[a], x, z) from None
+                raise _failure(form, exc, t_grid[a], x, z, dae_fn, t_grid[a + 1] - t_grid[a]) from None
             st = integ.stats()
             for k in STAT_KEYS:
                 stats[k] += int(st.get(k, 0))
@@ -182,19 +184,40 @@ def _split(form, x, z) -> dict:
     return out
 
 
-def _failure(form, exc, t, x, z) -> SolverError:
+def _failure(form, exc, t, x, z, dae_fn, dt) -> SolverError:
+    """Explain an IDAS failure: time, IDAS's reason, the largest algebraic residual (by name) of
+    the last accepted state pushed one output step ahead along its derivative, and constraint
+    rows that have become nearly dependent."""
     reason = str(exc).strip().splitlines()[-1] if str(exc).strip() else repr(exc)
-    dae = form.dae()
-    fn = ca.Function("alg", [dae["x"], dae["z"], dae["p"], dae["t"]], [dae["alg"]])
-    res = np.abs(np.asarray(fn(x, z, t, 0.0)).ravel())
+    nil = ca.DM(0, 1)
+    x_dot = np.asarray(dae_fn(0.0, x, z, t, nil)[0]).ravel()
+    res = np.abs(np.asarray(dae_fn(dt, x + dt * x_dot, z, t, nil)[1]).ravel())
     names = form.residual_names()
     worst = names[int(np.argmax(res))] if res.size else "none"
-    return SolverError(
-        f"IDAS failed in the step after t = {t:.6g} s: {reason}. Largest algebraic residual at the last "
-        f"accepted state: {worst} ({res.max(initial=0):.3g}). Try a smaller rtol or max_step, the other "
-        "formulation or index, or look for a joint or force that becomes singular; the results so far are "
-        "in .partial"
-    )
+    message = (f"IDAS failed in the step after t = {t:.6g} s: {reason}. Largest algebraic residual one "
+               f"output step ahead: {worst} ({res.max(initial=0):.3g}).")
+    message += _dependent_rows(form, x, z, t)
+    message += (" Try a smaller rtol or max_step, the other formulation or index, or look for a joint or "
+                "force that becomes singular; the results so far are in .partial")
+    return SolverError(message)
+
+
+def _dependent_rows(form, x, z, t) -> str:
+    model = form.model
+    if not 0 < model.n_c <= 2000:
+        return ""
+    parts = _split(form, x, z)
+    n_s = form.n_s
+    qs, vs, ss, ws = ca.MX.sym("q", form.n_f), ca.MX.sym("v", form.n_f), ca.MX.sym("s", n_s), ca.MX.sym("w", n_s)
+    k = form.terms(qs, vs, ss, ws, ca.MX(t))
+    jac = ca.Function("j", [qs, vs, ss, ws], [ca.horzcat(k["Cq"], k["Cs"])])
+    j = np.asarray(ca.densify(jac(parts["q"], parts["v"], parts["s"], parts.get("w", np.zeros(n_s)))))
+    u, sv, _ = np.linalg.svd(j, full_matrices=False)
+    if sv.size == 0 or sv[-1] > 1e-6 * sv[0]:
+        return ""
+    weights = np.abs(u[:, -1])
+    rows = [model.row_names[r] for r in np.argsort(weights)[::-1][:3] if weights[r] > 0.1]
+    return f" The constraints are nearly dependent (a locked or singular mechanism?): {', '.join(rows)}."
 
 
 def _result(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
