@@ -209,6 +209,10 @@ def main():
     print("code generation costs ...", flush=True)
     cg = codegen_costs()
     cold = cold_generate()
+    print("dynamics ...", flush=True)
+    from bench.dynamics import section as dynamics_section
+
+    dynamics = dynamics_section(REPORT)
     lines = [
         "# symcat benchmark report",
         "",
@@ -265,6 +269,7 @@ def main():
         "",
         "Target: below 2 s.",
         "",
+        *dynamics,
     ]
     (REPORT / "README.md").write_text("\n".join(lines))
     print(f"wrote {REPORT / 'README.md'}")

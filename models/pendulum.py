@@ -76,7 +76,6 @@ def run(p: dict) -> ModelOutput:
         tip = np.array(scene.rigid_bodies[1].position) + 0.5 * p["length"] * scene.rigid_bodies[1].rotation[:, 0]
         return ModelOutput({"tip_position_m": tip.tolist(), "energy_drift_rel": 0.0, "simulated_s": 0.0})
     res = simulate(model, p["t_end"], p["formulation"], p["index"], rtol=p["rtol"], atol=p["rtol"] * 1e-2, n_out=100, progress=True)
-    body = scene.rigid_bodies[1]
     from symcat.scene.rigid import rotation_matrix
 
     off = model.rigid_offset["rod2"]
@@ -93,8 +92,16 @@ def run(p: dict) -> ModelOutput:
         "simulated_s": p["t_end"],
         "steps": res.stats["steps"],
     }
-    del body
-    return ModelOutput(summary, res.stats, {"t_s": res.t_s, "tip_m": tips})
+    def write(out):
+        from symcat.results.timeseries import plot_histories
+
+        res.save(out / "pendulum.npz")
+        plot = plot_histories(res.t_s, {"tip x [m]": tips[:, 0], "tip y [m]": tips[:, 1],
+                                        "tip error [m]": np.abs(tips[:, :2] - ref).max(axis=1),
+                                        "energy change [J]": e - e[0]}, out / "pendulum.png")
+        return [out / "pendulum.npz", plot]
+
+    return ModelOutput(summary, res.stats, {"t_s": res.t_s, "tip_m": tips, "result": res}, write)
 
 
 MODEL = Model("pendulum", "planar double pendulum of rigid rods (revolute joints)", PARAMETERS, run)

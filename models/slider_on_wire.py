@@ -76,7 +76,17 @@ def run(p: dict) -> ModelOutput:
         "simulated_s": p["t_end"],
         "steps": res.stats["steps"],
     }
-    return ModelOutput(summary, res.stats, {"result": res})
+    def write(out):
+        from symcat.results.timeseries import plot_histories
+
+        res.save(out / "slider_on_wire.npz")
+        force = res.reactions_N["slider"]
+        plot = plot_histories(res.t_s, {"s [m]": res.s_m[:, 0], "contact force z [N]": force[:, 2],
+                                        "position drift [m]": res.position_drift}, out / "slider_on_wire.png",
+                              title=f"{p['formulation']}, index {p['index']}")
+        return [out / "slider_on_wire.npz", plot]
+
+    return ModelOutput(summary, res.stats, {"result": res}, write)
 
 
 MODEL = Model("slider_on_wire", "a body hanging from a sliding joint on a flexible wire", PARAMETERS, run)
