@@ -31,6 +31,7 @@ PARAMETERS = [
     Parameter("t_end", 1.0, "s", "simulated time", minimum=0.0),
     Parameter("rtol", 1e-6, "-", "IDAS relative tolerance", minimum=1e-12, maximum=1e-2),
     Parameter("window", 16, "-", "elements in the moving window of the sliding joint", minimum=2, maximum=100000),
+    Parameter("cholesky", False, "", "Cholesky coordinates for the wire (identity mass matrix)"),
 ]
 
 
@@ -64,7 +65,7 @@ def run(p: dict) -> ModelOutput:
         return ModelOutput({"s_final_m": p["s0"], "body_position_m": list(scene.rigid_bodies[0].position),
                             "max_position_drift_m": 0.0, "simulated_s": 0.0, "steps": 0})
     res = simulate(model, p["t_end"], p["formulation"], p["index"], rtol=p["rtol"], atol=p["rtol"] * 1e-2,
-                   n_out=max(20, int(200 * p["t_end"])))
+                   n_out=max(20, int(200 * p["t_end"])), cholesky=p["cholesky"])
     off = model.rigid_offset["body"]
     summary = {
         "s_final_m": float(res.s_m[-1, 0]),

@@ -59,9 +59,14 @@ class Formulation:
     index : {"1", "ggl"}
     baumgarte : float
         Baumgarte parameter (1/s) of the index-1 forms: ``alpha = beta = baumgarte``.
+    cholesky : bool
+        Use Cholesky coordinates ``p = U e`` for the free ANCF coordinates (seed, Section 5):
+        their mass matrix becomes the identity, at the price of ``U^-1``, which is dense, in
+        every Jacobian (see the benchmark for whether it pays).
     """
 
-    def __init__(self, model: MultibodyModel, formulation: str = "augmented", index: str = "1", baumgarte: float = 10.0):
+    def __init__(self, model: MultibodyModel, formulation: str = "augmented", index: str = "1", baumgarte: float = 10.0,
+                 cholesky: bool = False):
         if formulation not in FORMULATIONS:
             raise ParameterError(f"formulation={formulation!r}: must be one of {', '.join(FORMULATIONS)}")
         if str(index) not in INDICES:
@@ -73,7 +78,11 @@ class Formulation:
         n_q = model.n_q
         self.n_f = len(model.free)
         p = sps.csc_matrix((np.ones(self.n_f), (model.free, np.arange(self.n_f))), shape=(n_q, self.n_f))
-        self.P = ca.DM(to_casadi_sparse(p))
+        self.cholesky = bool(cholesky)
+        self._transform = None
+        if self.cholesky:
+            p = p @ self._cholesky_transform()
+        self.P = ca.DM(to_casadi_sparse(sps.csc_matrix(p)))
         q_fixed = model.q0.copy()
         q_fixed[model.free] = 0.0
         self.q_fixed = ca.DM(q_fixed)
@@ -81,6 +90,30 @@ class Formulation:
         tang = model.tangency_rows
         self.rows_t = tang
         self.rows_r = [r for r in range(self.n_c) if r not in set(tang)]
+
+    def _cholesky_transform(self) -> sps.csc_matrix:
+        """``T`` with physical free coordinates ``= T *`` internal ones: ``U^-1`` on the ANCF block."""
+        from ..assembly.cholesky import CholeskyCoordinates
+
+        model = self.model
+        ancf = np.flatnonzero(model.free < model.ancf.n)
+        if ancf.size == 0:
+            raise ParameterError("cholesky=True: the model has no free ANCF coordinates")
+        free_ancf = model.free[ancf]
+        chol = CholeskyCoordinates(model.ancf.mass_matrix[free_ancf][:, free_ancf])
+        u_inv = chol.from_cholesky(np.eye(ancf.size))  # dense: the price of Cholesky coordinates
+        t = np.eye(self.n_f)
+        t[np.ix_(ancf, ancf)] = u_inv
+        self._transform = (t, np.linalg.inv(t))
+        return sps.csc_matrix(t)
+
+    def to_internal(self, y_free: np.ndarray) -> np.ndarray:
+        """Physical free coordinates (or velocities) -> the DAE's coordinates."""
+        return y_free if self._transform is None else self._transform[1] @ y_free
+
+    def to_physical(self, y: np.ndarray) -> np.ndarray:
+        """The DAE's coordinates -> physical free coordinates."""
+        return y if self._transform is None else self._transform[0] @ y
 
     # --- shared pieces ------------------------------------------------------------------------
     def terms(self, q_f, v_f, s, w, t):

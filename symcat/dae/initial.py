@@ -36,8 +36,8 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     """
     model = form.model
     fn = _terms_function(form)
-    q = model.q0[model.free].copy()
-    v = model.v0[model.free].copy()
+    q = form.to_internal(model.q0[model.free].copy())
+    v = form.to_internal(model.v0[model.free].copy())
     s = model.s0.copy()
     w = np.zeros(form.n_s)
     names = model.row_names

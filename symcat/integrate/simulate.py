@@ -81,7 +81,7 @@ class SimulationResult:
 def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented", index: str = "1",
              rtol: float = 1e-6, atol: float = 1e-8, n_out: int = 200, baumgarte: float = 10.0,
              chunks: int | None = None, max_step: float | None = None, progress: bool = True,
-             algebraic_atol: float = 1e-3, max_steps: int = 500000) -> SimulationResult:
+             algebraic_atol: float = 1e-3, max_steps: int = 500000, cholesky: bool = False) -> SimulationResult:
     """Simulate ``model`` from 0 to ``t_end`` seconds.
 
     Parameters
@@ -106,13 +106,15 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
         error-controlled).
     max_steps : int
         IDAS steps allowed per chunk.
+    cholesky : bool
+        Cholesky coordinates for the ANCF bodies (see :class:`symcat.dae.Formulation`).
     """
     if not t_end > 0:
         raise ParameterError(f"t_end={t_end}: must be > 0 s")
     if not 0 < rtol < 1:
         raise ParameterError(f"rtol={rtol}: must be in (0, 1)")
     wall0 = time.perf_counter()
-    form = Formulation(model, formulation, index, baumgarte)
+    form = Formulation(model, formulation, index, baumgarte, cholesky)
     x, z = consistent_state(form, 0.0)
     t_grid = np.linspace(0.0, t_end, n_out + 1)
     n_chunks = chunks or max(1, n_out // 10)
@@ -240,8 +242,8 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
     q = np.tile(model.q0, (len(parts), 1))
     v = np.zeros_like(q)
     for k, p in enumerate(parts):
-        q[k, model.free] = p["q"]
-        v[k, model.free] = p["v"]
+        q[k, model.free] = form.to_physical(p["q"])
+        v[k, model.free] = form.to_physical(p["v"])
     s = np.array([p["s"] for p in parts]).reshape(len(parts), n_s)
     qs, vs = ca.MX.sym("q", n_f), ca.MX.sym("v", n_f)
     ss, ws, ts = ca.MX.sym("s", n_s), ca.MX.sym("w", n_s), ca.MX.sym("t")

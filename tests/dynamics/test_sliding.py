@@ -103,3 +103,12 @@ def test_sliding_across_a_hundred_element_ends_is_smooth():
     assert np.abs(np.diff(force)).max() < 5e-3 * force.mean()
     np.testing.assert_allclose(moving.s_m, fixed_window.s_m, atol=1e-5)  # both within the integration error
     np.testing.assert_allclose(moving.reactions_N["joint"], fixed_window.reactions_N["joint"], atol=1e-4 * force.mean())
+
+
+def test_cholesky_coordinates_give_the_same_motion():
+    common = {"t_end": 0.2, "rtol": 1e-8, "n_elements": 6}
+    a = run_model("slider_on_wire", common).arrays["result"]
+    c = run_model("slider_on_wire", {**common, "cholesky": True}).arrays["result"]
+    np.testing.assert_allclose(c.s_m, a.s_m, atol=1e-7)
+    np.testing.assert_allclose(c.q, a.q, atol=1e-7)
+    assert np.abs(c.reactions_N["slider"] - a.reactions_N["slider"]).max() < 1e-3 * np.abs(a.reactions_N["slider"]).max()
