@@ -90,7 +90,12 @@ def section(report_dir) -> list[str]:
         "|---|---|---:|---:|---:|---:|---:|---:|---|",
         *[f"| {f} | {i} | {n} | {r:g} | {e:.2e} | {w:.2f} | {s} | {j} | {note} |" for f, i, n, r, e, w, s, j, note in rows],
         "",
-        "Mesh (rtol 1e-6): | elements | s(t_end) [m] | body z [m] | wall [s] | steps |",
+        "The step count grows with the tolerance because IDAS resolves the wire's axial and bending "
+        "vibrations (the wire is released straight, not from equilibrium); the body position itself is "
+        "accurate to 1e-8 m already at rtol 1e-4. Residual evaluations are about 1.5 per step (Newton "
+        "iterations), Jacobians are formed once per 20-30 steps.",
+        "",
+        "Mesh study at rtol 1e-6 (the same 0.5 s):",
         "",
         "| elements | s_final [m] | body z [m] | wall [s] | steps |",
         "|---:|---:|---:|---:|---:|",
