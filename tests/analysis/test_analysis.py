@@ -84,3 +84,21 @@ def test_a_mechanism_fails_with_a_clear_error_and_keeps_the_partial_result():
         solve_static(assemble(scene), max_iterations=8, min_step=0.05)
     assert "load factor" in str(info.value) and info.value.partial is not None
     assert info.value.partial.load_factor < 1
+
+
+def test_wire_pulled_by_a_prescribed_end_tension():
+    """One end pinned, the other free to slide along the axis under a dead force T: the wire
+    stretches by T L / EA and carries T (checked through the strain kernel)."""
+    section = Section.circle(0.012)
+    material = Material(1.2e11, 8900)
+    wire = AncfBody.straight("w", "cable3d", [0, 0, 0], [20.0, 0, 0], 10, material, section)
+    wire.pin(0).fix(-1, ["y", "z"])
+    scene = Scene()
+    scene.add(wire)
+    scene.add(NodalForce("w", -1, (15e3, 0.0, 0.0)))
+    system = assemble(scene)
+    q = solve_static(system).q
+    ea = material.E * section.A
+    assert q[system.dofs.index(wire, -1, "x")] == pytest.approx(20.0 * (1 + 15e3 / ea), rel=1e-12)
+    eps = system.body_set("w").lib["cable3d_strain"](q[system.dofs.element_indices(wire)[3]], 0.3, wire.params[3])[0]
+    assert float(eps) * ea == pytest.approx(15e3, rel=1e-9)
