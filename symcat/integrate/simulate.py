@@ -99,7 +99,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     baumgarte : float
         Stabilization (1/s) of the index-1 forms.
     chunks : int, optional
-        Integrator calls the run is split into (default: adaptive, about 20, shorter while a
+        Integrator calls the run is split into (default: adaptive, about 10, shorter while a
         sliding point would otherwise leave its element window).
     max_step : float, optional
         Largest IDAS step (s).
@@ -181,17 +181,20 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
 
 
 def _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges) -> int:
-    """End (output index) of the next integrator call: about 5 % of the run for progress, and
+    """End (output index) of the next integrator call: about 10 % of the run for progress, and
     short enough that no sliding point travels more than a quarter of its window (the window
-    is only moved between calls). Each call builds an integrator, so fewer is faster."""
+    is only moved between calls). Each call builds an integrator and restarts IDAS at order 1,
+    so fewer calls are faster."""
     if fixed_edges is not None:
         return int(fixed_edges[np.searchsorted(fixed_edges, a, side="right")])
     dt = t_grid[1] - t_grid[0]
-    span = max(1, int(round(0.05 * n_out)))
+    span = max(1, int(round(0.1 * n_out)))
     if model.sliding:
         s_dot = np.abs(_s_dot(form, x, z))
         for sl, v in zip(model.sliding, s_dot):
             lo, hi = sl.window
+            if lo == 0 and hi == len(sl.element_start) - 1:
+                continue  # the window is the whole wire
             reach = 0.25 * (sl.element_start[hi] - sl.element_start[lo])
             if v > 0:
                 span = min(span, max(1, int(reach / (v * dt))))
