@@ -238,14 +238,12 @@ class MultibodyModel:
             return
         if isinstance(force, SpringDamper):
             a, b = self.side(force.body_i, force.at_i), self.side(force.body_j, force.at_j)
-            if a.kind == "ground":
-                a, b = b, a
-            if a.kind == "node" and b.kind == "rigid":
+            order = {"node": 0, "rigid": 1, "ground": 2}  # libraries exist in this order of kinds
+            if order[a.kind] > order[b.kind]:
                 a, b = b, a
             library = f"springdamper_{a.kind}_{b.kind}"
-            if a.kind == "rigid" and b.kind == "node":
-                library = "springdamper_node_rigid"
-                a, b = b, a
+            if a.kind == "ground":
+                raise ParameterError(f"spring-damper {force.name!r}: both ends on the ground")
             length0 = float(np.linalg.norm(np.asarray(force.at_j, float) - np.asarray(force.at_i, float)))
             values = {f"ui_{k}": a.local["u"][k] for k in range(3)}
             values.update({f"uj_{k}": b.local["u"][k] for k in range(3)})

@@ -40,7 +40,9 @@ class SimulationResult:
         from the KKT system of eq. (25) for the integrated state, so they are exact for that
         state and identical in meaning for every formulation.
     reactions_N : dict
-        Joint name -> (n_t, 3) constraint force on body j (global, N).
+        Joint name -> (n_t, 3) constraint force (global, N) on the joint's ``body`` (sliding
+        and driving joints) or ``body_j`` (two-body joints; on the ground: minus the force on
+        ``body_i``).
     energy_J : dict
         ``kinetic``, ``potential`` and ``total`` (n_t,).
     position_drift, velocity_drift : ndarray (n_t,)
@@ -341,17 +343,15 @@ def _reactions(model, form, cq_free, lam, reactions, i):
 
 
 def _force_on_j(model, name, gen):
-    for j in model.scene.joints:
-        if j.name == name:
-            if hasattr(j, "body_j") and j.body_j != "ground":
-                ref = j.body_j
-            elif hasattr(j, "body") :
-                ref = j.body
-            else:
-                ref, sign = j.body_i, -1.0
-                return sign * gen[_first3(model, ref)]
-            return gen[_first3(model, ref)]
-    return np.zeros(3)
+    """Force on the joint's reporting body: ``body`` of sliding and driving joints, ``body_j``
+    of two-body joints, or the ground (minus the force on ``body_i``)."""
+    joint = next((j for j in model.scene.joints if j.name == name), None)
+    if joint is None:  # Euler-parameter normalization rows carry no force
+        return np.zeros(3)
+    ref = getattr(joint, "body", None) or joint.body_j
+    if ref == "ground":
+        return -gen[_first3(model, joint.body_i)]
+    return gen[_first3(model, ref)]
 
 
 def _first3(model, ref):
