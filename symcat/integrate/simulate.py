@@ -146,9 +146,11 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     dae_fn = None
     done = 0
     try:
-        a = 0
+        a, limit = 0, None
         while a < n_out:
             b = _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges)
+            if limit is not None:
+                b = min(b, a + limit)
             if _update_windows(model, form, x, z) or dae_fn is None:
                 stats["restarts"] += dae_fn is not None
                 d = form.dae()
@@ -162,11 +164,23 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             try:
                 out = integ(x0=x, z0=z, p=t_grid[a])
             except RuntimeError as exc:
+                if b - a > 1 and model.sliding:
+                    # Possibly a sliding point left its window: retry shorter before giving up.
+                    stats["retries"] = stats.get("retries", 0) + 1
+                    limit = max(1, (b - a) // 2)
+                    continue
                 raise _failure(form, exc, t_grid[a], x, z, dae_fn, t_grid[a + 1] - t_grid[a]) from None
             st = integ.stats()
             for k in STAT_KEYS:
                 stats[k] += int(st.get(k, 0))
             xf, zf = np.asarray(out["xf"]), np.asarray(out["zf"])
+            if b - a > 1 and any(_left_window(model, form, xf[:, j], zf[:, j]) for j in range(b - a)):
+                # A sliding point ran out of its window inside the call (the physics there would
+                # be an extrapolated element): redo the call, shorter, from the same state.
+                stats["retries"] = stats.get("retries", 0) + 1
+                limit = max(1, (b - a) // 2)
+                continue
+            limit = None
             for j in range(b - a):
                 xs.append(xf[:, j])
                 zs.append(zf[:, j])
@@ -201,6 +215,19 @@ def _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges) -> int:
             if v > 0:
                 span = min(span, max(1, int(reach / (v * dt))))
     return min(n_out, a + span)
+
+
+def _left_window(model, form, x, z) -> bool:
+    """True if a sliding point lies outside its window (wire ends excepted)."""
+    if not model.sliding:
+        return False
+    s = _split(form, x, z)["s"]
+    for sl, s_k in zip(model.sliding, s):
+        lo, hi = sl.window
+        n_el = len(sl.element_start) - 1
+        if (lo > 0 and s_k < sl.element_start[lo]) or (hi < n_el and s_k > sl.element_start[hi]):
+            return True
+    return False
 
 
 def _s_dot(form, x, z) -> np.ndarray:
