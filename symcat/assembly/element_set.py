@@ -102,8 +102,9 @@ class ElementSet:
         e = np.asarray(q)[self.indices].T  # n_loc x N
         pos = self.lib[f"{self.element.name}_position"]
         rs, slopes = [], []
-        for k, x in enumerate(xi if self.n == 0 else xi):
-            r, rx = pos.map(self.n)(e, x, self._p)
+        mapped = pos.map(self.n)
+        for x in xi:
+            r, rx = mapped(e, x, self._p)
             rs.append(np.asarray(r).T)
             slopes.append(np.asarray(rx).T)
         r = np.stack(rs, axis=1)  # N x (P+1) x dim
