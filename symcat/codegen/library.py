@@ -120,7 +120,17 @@ def kernel_library(name: str) -> KernelLibrary:
     return lib
 
 
+_INTERFACES: dict[str, dict] = {}
+
+
 def library_interface(name: str) -> dict:
-    """Sizes and parameter names of a multibody library, from the manifest (no SymPy)."""
-    ensure_generated(name)
-    return read_manifest()["libraries"][name]["interface"]
+    """Sizes and parameter names of a multibody library, from the manifest (no SymPy).
+
+    Cached per process: scenes ask once per joint or force instance, and each uncached look-up
+    re-hashes the symbolic sources and re-reads the manifest.
+    """
+    info = _INTERFACES.get(name)
+    if info is None:
+        ensure_generated(name)
+        info = _INTERFACES[name] = read_manifest()["libraries"][name]["interface"]
+    return info
