@@ -1,4 +1,5 @@
-"""Command line: ``symcat run <model> [--set name=value ...] [--out DIR] [--summary FILE.json]``."""
+"""Command line: ``symcat run <model> [--set name=value ...] [--out DIR] [--summary FILE.json]``,
+``symcat list`` and ``symcat validate en50318``."""
 from __future__ import annotations
 
 import argparse
@@ -21,6 +22,10 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--quiet", action="store_true", help="do not print the summary")
     run.add_argument("-h", "--help", action="store_true", help="list the model's parameters")
     sub.add_parser("list", help="list the available models")
+    val = sub.add_parser("validate", help="validate against a standard: en50318")
+    val.add_argument("standard", choices=["en50318"])
+    val.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="set a model parameter")
+    val.add_argument("--out", help="folder for the plots and summaries of both runs")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s: %(message)s")
     try:
@@ -29,17 +34,17 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "list":
             print("\n".join(available_models()))
             return 0
+        if args.command == "validate":
+            from .validation import validate_en50318
+
+            table, passed, _ = validate_en50318(_parse_sets(args.set), out=args.out)
+            print(table)
+            return 0 if passed else 1
         model = load_model(args.model)
         if args.help:
             print(model.help())
             return 0
-        values = {}
-        for item in args.set:
-            if "=" not in item:
-                raise SymcatError(f"--set {item!r}: expected name=value")
-            name, value = item.split("=", 1)
-            values[name.strip()] = value.strip()
-        result = run_model(model, values, out=args.out, summary_path=args.summary)
+        result = run_model(model, _parse_sets(args.set), out=args.out, summary_path=args.summary)
         if not args.quiet:
             print(json.dumps(result.summary, indent=1, default=lambda x: getattr(x, "tolist", lambda: str(x))()))
         return 0
@@ -49,6 +54,16 @@ def main(argv: list[str] | None = None) -> int:
         if partial is not None:
             print("symcat: the partial result was kept in the exception (Python API)", file=sys.stderr)
         return 2
+
+
+def _parse_sets(items: list[str]) -> dict:
+    values = {}
+    for item in items:
+        if "=" not in item:
+            raise SymcatError(f"--set {item!r}: expected name=value")
+        name, value = item.split("=", 1)
+        values[name.strip()] = value.strip()
+    return values
 
 
 if __name__ == "__main__":

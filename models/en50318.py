@@ -1,0 +1,41 @@
+"""The EN 50318:2002 reference model: reference catenary and two-mass pantograph at 250 or 300 km/h.
+
+The catenary is the reference model as reproduced in public papers (10 spans of 60 m, nine
+droppers, 20 kN / 16 kN); the choices the public data leave open are listed by
+``symcat.catenary.en50318`` (encumbrance 1.2 m, wire EA, presag parabola between the end
+droppers, no dropper or clamp masses, Rayleigh damping fitted to 0.5 % at 1 and 20 Hz, no
+stagger). The pantograph is the two-mass reference with a static force of 120 N on the frame
+(public sources disagree; a parameter). ``symcat validate en50318`` runs both speeds and checks
+the statistics against the standard's ranges.
+"""
+from __future__ import annotations
+
+from symcat.catenary import en50318
+from symcat.errors import ParameterError
+from symcat.interaction.model_support import NUMERICAL_PARAMETERS, numerical_options, passage_output
+from symcat.interaction.passage import run_passage
+from symcat.model import Model, Parameter
+from symcat.pantograph import en50318_pantograph
+
+PARAMETERS = [
+    Parameter("speed_kmh", 250.0, "km/h", "train speed: the standard's reference cases are 250 and 300 km/h",
+              minimum=0.0, exclusive_minimum=True),
+    Parameter("static_force_N", 120.0, "N", "static force on the pantograph frame", minimum=0.0, exclusive_minimum=True),
+    Parameter("n_spans", 10, "-", "spans of the line", minimum=4, maximum=200),
+] + NUMERICAL_PARAMETERS
+
+
+def run(p: dict):
+    design = en50318(p["n_spans"])
+    speed = p["speed_kmh"] / 3.6
+    if not speed < design.wave_speed:
+        raise ParameterError(f"speed_kmh={p['speed_kmh']:g} km/h: must be below the contact-wire wave speed "
+                             f"{design.wave_speed * 3.6:.1f} km/h")
+    panto = en50318_pantograph(p["static_force_N"])
+    result = run_passage(design, [panto], speed, **numerical_options(p))
+    extra = {"speed_kmh": p["speed_kmh"], "static_force_N": p["static_force_N"],
+             "wave_speed_kmh": design.wave_speed * 3.6, "choices": design.sources}
+    return passage_output(result, p, "en50318", extra)
+
+
+MODEL = Model("en50318", "EN 50318:2002 reference catenary and pantograph (250 or 300 km/h)", PARAMETERS, run)

@@ -1,0 +1,202 @@
+"""Static form finding: dropper lengths that make the contact wire hang at its design height.
+
+1. The contact wire alone, held at its target height at every dropper and support, carries its
+   weight, the clamps and half of each dropper; the vertical reactions there are the dropper
+   tensions and the steady-arm preloads.
+2. The messenger, held at the supports, carries its weight and those dropper tensions; its
+   shape gives the dropper directions and lengths.
+3. Steps 1-2 repeat with the dropper directions (not quite vertical once the wires stretch)
+   until the lengths settle; the unstretched length of a dropper is its length less its
+   elastic stretch under its tension.
+4. The assembled catenary with these droppers and support preloads is solved once more as a
+   whole (a check: it must stay at the design height) and is the starting state of every run.
+"""
+from __future__ import annotations
+
+import copy
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from ..analysis.statics import solve_static
+from ..assembly.system import System
+from ..errors import ParameterError, SolverError
+from ..scene import NodalForce, Scene
+from .design import CatenaryDesign
+from .structure import CatenaryStructure
+
+
+@dataclass
+class FormFindingResult:
+    """Outcome of :func:`find_form`.
+
+    Attributes
+    ----------
+    structure : CatenaryStructure
+        The catenary with dropper lengths and support preloads set.
+    q : ndarray
+        Static equilibrium of the whole catenary (m, -).
+    dropper_length_m, dropper_tension_N : ndarray
+        Unstretched lengths and static tensions of all droppers.
+    height_error_m : float
+        Largest deviation of the contact wire from its target height at the droppers and
+        supports in the final coupled equilibrium.
+    iterations : int
+        Contact/messenger iterations.
+    wall_s : float
+    """
+
+    structure: CatenaryStructure
+    q: np.ndarray
+    dropper_length_m: np.ndarray
+    dropper_tension_N: np.ndarray
+    height_error_m: float
+    iterations: int
+    wall_s: float
+
+
+def _solve_wire(body, fixed_nodes, loads, gravity) -> tuple[np.ndarray, np.ndarray, System]:
+    """Static equilibrium of one wire with the given pins and loads; returns (nodes, reactions)."""
+    body = copy.deepcopy(body)
+    body.fixed.clear()
+    for node, coords in fixed_nodes:
+        body.fix(int(node), coords)
+    scene = Scene(gravity=(0.0, 0.0, -gravity))
+    scene.add(body)
+    for node, force in loads:
+        scene.add(NodalForce(body.name, int(node), tuple(float(f) for f in force)))
+    system = System(scene)
+    result = solve_static(system, rtol=1e-11, max_iterations=30)
+    residual, _ = system.eval_static(result.q, 1.0)
+    reactions = -residual.reshape(body.q0.shape)
+    return result.q.reshape(body.q0.shape), reactions, system
+
+
+def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "cable3d", tol: float = 1e-9,
+              max_iterations: int = 20) -> FormFindingResult:
+    """Dropper lengths and static equilibrium for ``design`` (see the module docstring).
+
+    Raises
+    ------
+    ParameterError
+        If the presag target needs a dropper in compression or the messenger hangs below the
+        contact wire (the design cannot be reached).
+    """
+    t0 = time.perf_counter()
+    d = design
+    st = CatenaryStructure(d, elements_per_span, element)
+    drop, sup = st.dropper_nodes, st.support_nodes
+    inner = sup[1:-1]
+    n_nodes = st.x.size
+    pos = lambda nodes: nodes[:, :3]
+    direction = np.tile([0.0, 0.0, 1.0], (drop.size, 1))
+    tension = np.zeros(drop.size)
+    length0 = np.full(drop.size, d.encumbrance)
+    beam_extra = ["z_y", "y_z"] if element == "beam3d" else []
+    last_change = np.inf
+    for iteration in range(1, max_iterations + 1):
+        half = 0.5 * d.dropper_mass_per_length * length0 * d.gravity
+        # 1. contact wire held at the design height at droppers and supports
+        fixed = [(0, ["x", "y", "z"] + beam_extra), (n_nodes - 1, ["y", "z"])]
+        fixed += [(k, ["y", "z"]) for k in inner] + [(k, ["z"]) for k in drop]
+        loads = [(n_nodes - 1, (d.contact_wire.tension, 0.0, 0.0))]
+        for k, node in enumerate(drop):
+            w = -(d.clamp_mass_contact * d.gravity + half[k])
+            loads.append((node, (tension[k] * direction[k, 0], tension[k] * direction[k, 1], w)))
+        for node in inner:
+            loads.append((node, (0.0, 0.0, -d.steady_arm_mass * d.gravity)))
+        cw, cw_react, _ = _solve_wire(st.contact, fixed, loads, d.gravity)
+        vertical = cw_react[drop, 2]
+        tension = vertical / direction[:, 2]
+        if np.any(tension <= 0):
+            k = int(np.argmin(tension))
+            raise ParameterError(
+                f"presag: the target needs the dropper at x={d.dropper_x()[k]:g} m in compression "
+                f"(tension {tension[k]:.1f} N); reduce the presag or its curvature")
+        # 2. messenger under the dropper tensions
+        fixed = [(0, ["x", "y", "z"] + beam_extra), (n_nodes - 1, ["y", "z"])] + [(k, ["y", "z"]) for k in inner]
+        loads = [(n_nodes - 1, (d.messenger_wire.tension, 0.0, 0.0))]
+        for k, node in enumerate(drop):
+            w = -(d.clamp_mass_messenger * d.gravity + half[k])
+            loads.append((node, tuple(-tension[k] * direction[k] + np.array([0.0, 0.0, w]))))
+        mw_start = copy.deepcopy(st.messenger)
+        mw_start.q0[inner, 2] = d.contact_wire_height + d.encumbrance
+        mw_start.q0[[0, -1], 2] = d.contact_wire_height + d.encumbrance
+        mw, mw_react, _ = _solve_wire(mw_start, fixed, loads, d.gravity)
+        delta = pos(mw)[drop] - pos(cw)[drop]
+        distance = np.linalg.norm(delta, axis=1)
+        if np.any(delta[:, 2] <= 0):
+            k = int(np.argmin(delta[:, 2]))
+            raise ParameterError(
+                f"encumbrance={d.encumbrance:g} m: the messenger sags below the contact wire at x={d.dropper_x()[k]:g} m; "
+                "increase the encumbrance or the messenger tension")
+        direction = delta / distance[:, None]
+        tension = vertical / direction[:, 2]
+        k_law = d.dropper_stiffness
+        new_length0 = distance - tension / k_law if k_law > 0 else distance / (1 + tension / d.dropper_EA)
+        if np.any(new_length0 <= 0):
+            raise ParameterError("dropper_stiffness: a dropper stretches beyond its own length; increase it")
+        last_change = np.max(np.abs(new_length0 - length0))
+        length0 = new_length0
+        st.contact.q0[:] = cw
+        st.messenger.q0[:] = mw
+        st.mw_supports.preload = mw_react[inner, 2].copy()
+        st.cw_supports.preload = cw_react[inner, 2].copy()
+        if last_change < tol:
+            break
+    else:
+        raise SolverError(f"form finding: dropper lengths still changed by {last_change:.3g} m after "
+                          f"{max_iterations} iterations (tol={tol:g} m)")
+    st.mw_supports.height = mw[inner, 2].copy()
+    st._build_system()
+    st.set_dropper_lengths(length0)
+    q = coupled_equilibrium(st, st.q0)
+    target = d.target_height(st.x[np.concatenate([drop, inner])])
+    height_error = float(np.max(np.abs(st.contact_wire_z(q)[np.concatenate([drop, inner])] - target)))
+    _, _, tension = st.dropper_state(q)
+    return FormFindingResult(st, q, length0, tension, height_error, iteration, time.perf_counter() - t0)
+
+
+def coupled_equilibrium(structure: CatenaryStructure, q: np.ndarray, extra=None, rtol: float = 1e-10,
+                        max_iterations: int = 40) -> np.ndarray:
+    """Static equilibrium of the assembled catenary by Newton's method (tangent with the
+    current dropper states, backtracking on the residual norm).
+
+    ``extra(q) -> (force, stiffness)`` adds further forces (e.g. pantograph contact) and their
+    ``-d force/d q`` (sparse, n x n, or None).
+    """
+    free = structure.free
+    q = np.array(q, dtype=float)
+
+    def residual(q):
+        f = structure.forces(q)
+        if extra is not None:
+            f = f + extra(q)[0]
+        return f[free]
+
+    scale = max(1.0, np.abs(structure._f_ext[free]).max())
+    r = residual(q)
+    for it in range(max_iterations):
+        if np.abs(r).max() < rtol * scale:
+            return q
+        k = structure.stiffness(q)
+        if extra is not None:
+            k_extra = extra(q)[1]
+            if k_extra is not None:
+                k = k + k_extra
+        dq = spla.spsolve(k[free][:, free].tocsc(), r)
+        alpha, norm0 = 1.0, np.linalg.norm(r)
+        while True:
+            trial = q.copy()
+            trial[free] += alpha * dq
+            r_trial = residual(trial)
+            if np.linalg.norm(r_trial) < norm0 or alpha < 1e-3:
+                break
+            alpha *= 0.5
+        q, r = trial, r_trial
+    if np.abs(r).max() < 1e-6 * scale:
+        return q
+    raise SolverError(f"catenary static equilibrium: residual {np.abs(r).max():.3g} N after {max_iterations} "
+                      "Newton iterations; check supports and dropper lengths")

@@ -1,0 +1,249 @@
+"""Catenary and lumped pantographs coupled by contact, as ``M y'' = F(y, y', t) + contact``.
+
+The unknowns ``y`` are the free catenary coordinates followed by the stage displacements of
+each pantograph. Pantograph ``p`` runs at ``speed`` from ``x_start``; its pan-head height is
+``z_ref + u_head`` and its penetration into the wire ``delta = z_head - z_wire(x_c(t))``.
+Contact is either a penalty (``f = max(k delta + c delta', 0)`` while ``delta > 0``) or a
+bilateral constraint ``delta = 0`` with the contact force as multiplier.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
+
+from ..catenary.formfinding import FormFindingResult
+from ..errors import ParameterError, SolverError
+from ..pantograph.lumped import LumpedPantograph
+from .contact import WireLocator, WirePoint
+
+CONTACT_MODELS = ("penalty", "bilateral")
+
+
+@dataclass(frozen=True)
+class PantographRun:
+    """A pantograph on the line: its model and where it starts (m along the line)."""
+
+    pantograph: LumpedPantograph
+    x_start: float
+
+
+@dataclass
+class ContactState:
+    """Contact of one pantograph at one instant."""
+
+    point: WirePoint
+    delta: float  # penetration (m), > 0 when pressing into the wire
+    delta_rate: float  # m/s
+    g: np.ndarray  # d delta / d y on the entries ``g_index``
+    g_index: np.ndarray
+
+
+class CoupledLine:
+    """Catenary + pantographs: mass, damping and iteration stiffness, forces, contact.
+
+    Parameters
+    ----------
+    form : FormFindingResult
+        The catenary in static equilibrium (without pantographs).
+    runs : list of PantographRun
+    speed : float
+        Train speed (m/s); must stay below the contact-wire wave speed.
+    contact : str
+        ``"penalty"`` or ``"bilateral"``.
+    contact_stiffness : float
+        Penalty stiffness (N/m).
+    contact_damping : float
+        Penalty damping (N s/m), acting only while in contact; the force never pulls.
+    """
+
+    def __init__(self, form: FormFindingResult, runs: list[PantographRun], speed: float, contact: str = "penalty",
+                 contact_stiffness: float = 5.0e4, contact_damping: float = 0.0):
+        st = form.structure
+        d = st.design
+        if contact not in CONTACT_MODELS:
+            raise ParameterError(f"contact={contact!r}: must be one of {', '.join(CONTACT_MODELS)}")
+        if not 0 < speed < d.wave_speed:
+            raise ParameterError(f"speed={speed:g} m/s ({speed * 3.6:g} km/h): must be > 0 and below the contact-wire "
+                                 f"wave speed {d.wave_speed:.1f} m/s ({d.wave_speed * 3.6:.1f} km/h)")
+        if contact == "penalty" and not contact_stiffness > 0:
+            raise ParameterError(f"contact_stiffness={contact_stiffness:g} N/m: must be > 0")
+        if contact_damping < 0:
+            raise ParameterError(f"contact_damping={contact_damping:g} N s/m: must be >= 0")
+        for k, run in enumerate(runs):
+            if not 0 <= run.x_start <= d.length:
+                raise ParameterError(f"pantograph {k + 1} x_start={run.x_start:g} m: off the wire; must be within "
+                                     f"0..{d.length:g} m")
+        self.form, self.structure, self.runs = form, st, list(runs)
+        self.speed, self.contact = float(speed), contact
+        self.k_c, self.c_c = float(contact_stiffness), float(contact_damping)
+        self.q_static = form.q.copy()
+        self.free = st.free
+        self.n_cat = self.free.size
+        self.in_free = np.full(st.n, -1)
+        self.in_free[self.free] = np.arange(self.n_cat)
+        offsets = np.cumsum([self.n_cat] + [r.pantograph.n for r in runs])
+        self.panto_slices = [slice(a, b) for a, b in zip(offsets[:-1], offsets[1:])]
+        self.head_index = np.array([s.stop - 1 for s in self.panto_slices], dtype=int)
+        self.n = int(offsets[-1])
+        dofs = st.system.dofs
+        body = st.contact
+        nodes = range(body.n_nodes)
+        self.locator = WireLocator(st.cw_xyz[:, 0], [dofs.index(body, k, "x_x") for k in nodes], st.cw_xyz[:, 2],
+                                   st.cw_zx, body.params[:, body.element.param_names.index("length")])
+        self.z_ref = np.array([d.target_height(r.x_start) for r in runs])
+        self._matrices()
+
+    # --- constant matrices ----------------------------------------------------------------
+    def _matrices(self) -> None:
+        st, f = self.structure, self.free
+        m_cat = st.mass_matrix[f][:, f]
+        k_cat = st.stiffness(self.q_static, droppers_taut=True)[f][:, f]
+        d = st.design
+        c_cat = d.rayleigh_alpha * m_cat + d.rayleigh_beta * k_cat
+        blocks = [r.pantograph.matrices() for r in self.runs]
+        self.M = sps.block_diag([m_cat] + [b[0] for b in blocks], format="csc")
+        self.C = sps.block_diag([c_cat] + [b[1] for b in blocks], format="csc")
+        self.K = sps.block_diag([k_cat] + [b[2] for b in blocks], format="csc")
+        self.C_cat = c_cat.tocsr()
+        self.K_panto = [b[2] for b in blocks]
+        self.C_panto = [b[1] for b in blocks]
+        self.f_panto = [r.pantograph.static_force(self.speed) for r in self.runs]
+
+    def catenary_q(self, y: np.ndarray) -> np.ndarray:
+        """Full catenary coordinates from ``y``."""
+        q = self.q_static.copy()
+        q[self.free] = y[: self.n_cat]
+        return q
+
+    def x_contact(self, t: float) -> np.ndarray:
+        """Pan-head positions along the line at time ``t`` (m)."""
+        return np.array([r.x_start + self.speed * t for r in self.runs])
+
+    # --- forces ---------------------------------------------------------------------------
+    def contact_states(self, y: np.ndarray, y_dot: np.ndarray, t: float) -> list[ContactState]:
+        q = self.catenary_q(y)
+        states = []
+        for p, x in enumerate(self.x_contact(t)):
+            point = self.locator.locate(q, x)
+            z_w = point.height(q)
+            head = self.head_index[p]
+            delta = self.z_ref[p] + y[head] - z_w
+            pos = self.in_free[point.index]
+            keep = pos >= 0
+            v_full = np.zeros(4)
+            v_full[keep] = y_dot[pos[keep]]
+            slope = self._slope(q, point)
+            rate = y_dot[head] - point.weights @ v_full - slope * self.speed
+            g_index = np.concatenate([[head], pos[keep]])
+            g = np.concatenate([[1.0], -point.weights[keep]])
+            states.append(ContactState(point, float(delta), float(rate), g, g_index))
+        return states
+
+    def _slope(self, q: np.ndarray, point: WirePoint) -> float:
+        """dz/dx of the contact wire at the contact point."""
+        from .contact import hermite
+
+        k, length = point.element, self.locator.lengths[point.element]
+        _, dn = hermite(point.xi)
+        lz = np.array([1.0, length, 1.0, length])
+        cz = q[point.index] * lz
+        ix = [self.locator.x_index[k], self.locator.xx_index[k], self.locator.x_index[k + 1], self.locator.xx_index[k + 1]]
+        cx = q[ix] * lz
+        return float((dn @ cz) / (dn @ cx))
+
+    def penalty_force(self, state: ContactState) -> float:
+        """Contact force (N, >= 0) of the penalty law."""
+        if state.delta <= 0:
+            return 0.0
+        return max(self.k_c * state.delta + self.c_c * state.delta_rate, 0.0)
+
+    def forces(self, y: np.ndarray, y_dot: np.ndarray, t: float, states=None,
+               contact_forces=None) -> tuple[np.ndarray, list[ContactState], np.ndarray]:
+        """Generalized force ``F`` (N) including contact; returns (F, contact states, contact forces).
+
+        For bilateral contact pass the multipliers as ``contact_forces``.
+        """
+        q = self.catenary_q(y)
+        v = np.zeros(self.structure.n)
+        v[self.free] = y_dot[: self.n_cat]
+        out = np.empty(self.n)
+        out[: self.n_cat] = self.structure.forces(q, v)[self.free] - self.C_cat @ y_dot[: self.n_cat]
+        for p, sl in enumerate(self.panto_slices):
+            out[sl] = self.f_panto[p] - self.K_panto[p] @ y[sl] - self.C_panto[p] @ y_dot[sl]
+        if states is None:
+            states = self.contact_states(y, y_dot, t)
+        if contact_forces is None:
+            contact_forces = np.array([self.penalty_force(s) for s in states])
+        for s, fc in zip(states, contact_forces):
+            np.add.at(out, s.g_index, -fc * s.g)
+        return out, states, np.asarray(contact_forces, dtype=float)
+
+    # --- static equilibrium ---------------------------------------------------------------
+    def _place_pantographs(self, y: np.ndarray, load: np.ndarray) -> None:
+        """Solve the catenary under the static contact forces ``load`` (N) and set each
+        pantograph's reference height so that it stands there with exactly that force: the
+        static uplift is the static contact force, as the standards define it."""
+        zero = np.zeros(self.n)
+        for _ in range(30):
+            states = self.contact_states(y, zero, 0.0)
+            f, states, _ = self.forces(y, zero, 0.0, states, load)
+            f_cat = f[: self.n_cat]
+            if np.abs(f_cat).max() < 1e-9 * max(1.0, float(np.abs(self.structure._f_ext).max())):
+                break
+            k_cat = self.structure.stiffness(self.catenary_q(y))[self.free][:, self.free]
+            y[: self.n_cat] += spla.spsolve(k_cat.tocsc(), f_cat)
+        q = self.catenary_q(y)
+        for p, (run, sl) in enumerate(zip(self.runs, self.panto_slices)):
+            m, c, k = run.pantograph.matrices()
+            rhs = self.f_panto[p].copy()
+            rhs[-1] -= load[p]
+            u = np.linalg.lstsq(k, rhs, rcond=None)[0]
+            y[sl] = u
+            gap = load[p] / self.k_c if self.contact == "penalty" else 0.0
+            point = self.locator.locate(q, self.x_contact(0.0)[p])
+            self.z_ref[p] = point.height(q) + gap - u[-1]
+
+    def static_state(self, rtol: float = 1e-9, max_iterations: int = 40) -> tuple[np.ndarray, np.ndarray]:
+        """Static equilibrium with the pantographs pressing at their start positions.
+
+        Returns ``(y, contact_forces)``. Newton's method on the tangent with the current dropper
+        states; the bilateral model solves for the multipliers with ``delta = 0``.
+        """
+        y = np.zeros(self.n)
+        y[: self.n_cat] = self.q_static[self.free]
+        zero = np.zeros(self.n)
+        n_c = len(self.runs)
+        lam = np.array([r.pantograph.static_force(self.speed).sum() for r in self.runs], dtype=float)
+        self._place_pantographs(y, lam)
+        lam = lam.copy()
+        scale = max(1.0, float(np.abs(self.structure._f_ext).max()))
+        for it in range(max_iterations):
+            states = self.contact_states(y, zero, 0.0)
+            if self.contact == "penalty":
+                f, states, fc = self.forces(y, zero, 0.0, states)
+            else:
+                f, states, fc = self.forces(y, zero, 0.0, states, lam)
+            k_cat = self.structure.stiffness(self.catenary_q(y))[self.free][:, self.free]
+            k = sps.block_diag([k_cat] + self.K_panto, format="lil")
+            g = sps.lil_matrix((self.n, n_c))
+            for p, s in enumerate(states):
+                g[s.g_index, p] = s.g[:, None]
+                if self.contact == "penalty" and s.delta > 0:
+                    k[np.ix_(s.g_index, s.g_index)] = k[np.ix_(s.g_index, s.g_index)].toarray() + self.k_c * np.outer(s.g, s.g)
+            delta = np.array([s.delta for s in states])
+            done = np.abs(f).max() < rtol * scale and (self.contact == "penalty" or np.abs(delta).max() < 1e-12)
+            if done:
+                return y, fc
+            if self.contact == "penalty":
+                dy = spla.spsolve(k.tocsc(), f)
+                y += dy
+            else:
+                kkt = sps.bmat([[k.tocsc(), g.tocsc()], [g.T.tocsc(), None]], format="csc")
+                sol = spla.spsolve(kkt, np.concatenate([f, -delta]))
+                y += sol[: self.n]
+                lam = lam + sol[self.n:]
+        raise SolverError(f"static equilibrium with pantographs: residual {np.abs(f).max():.3g} N after {max_iterations} "
+                          "iterations; check the pantograph start positions and uplift forces")

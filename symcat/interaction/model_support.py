@@ -1,0 +1,86 @@
+"""What the pantograph/catenary models share: numerical parameters, summary and file writer."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..model import ModelOutput, Parameter
+from .passage import PassageResult
+
+NUMERICAL_PARAMETERS = [
+    Parameter("elements_per_span", 20, "-", "contact/messenger-wire elements per span (rounded per dropper interval)",
+              minimum=1, maximum=400),
+    Parameter("element", "cable3d", "", "ANCF element of the wires", choices=("cable3d", "beam3d")),
+    Parameter("contact", "penalty", "", "penalty (unilateral, loss of contact) or bilateral (always on the wire)",
+              choices=("penalty", "bilateral")),
+    Parameter("contact_stiffness", 5.0e4, "N/m", "penalty contact stiffness", minimum=0.0, exclusive_minimum=True),
+    Parameter("contact_damping", 0.0, "N s/m", "penalty contact damping (only while in contact)", minimum=0.0),
+    Parameter("analysis_spans", 2, "-", "spans in the analysis section (central ones)", minimum=1, maximum=100),
+    Parameter("t_end", -1.0, "s", "simulated time; -1: until the last pantograph leaves the analysis section; "
+              "0: static equilibrium only", minimum=-1.0),
+    Parameter("dt", 1.0e-3, "s", "time step", minimum=1e-6, maximum=0.01),
+    Parameter("rho_inf", 0.8, "-", "generalized-alpha spectral radius at infinite frequency", minimum=0.0, maximum=1.0),
+    Parameter("tol", 1.0e-7, "m", "Newton tolerance on the coordinates", minimum=1e-13, maximum=1e-3),
+    Parameter("snapshot_interval", 0.05, "s", "interval of wire snapshots for ParaView", minimum=1e-4),
+    Parameter("paraview", True, "", "write the ParaView time series (VTU + .pvd)"),
+    Parameter("progress", True, "", "show a progress bar"),
+]
+
+
+def numerical_options(p: dict) -> dict:
+    """Keyword arguments of :func:`run_passage` from the shared parameters."""
+    return dict(elements_per_span=p["elements_per_span"], element=p["element"], contact=p["contact"],
+                contact_stiffness=p["contact_stiffness"], contact_damping=p["contact_damping"],
+                analysis_spans=p["analysis_spans"], dt=p["dt"], rho_inf=p["rho_inf"], tol=p["tol"],
+                t_end=None if p["t_end"] < 0 else p["t_end"], record_every=p["snapshot_interval"],
+                progress=p["progress"])
+
+
+def central_span_droppers(result: PassageResult) -> list[float]:
+    """Unstretched dropper lengths (m) of the span at the middle of the line."""
+    st = result.form.structure
+    d = st.design
+    k = d.n_spans // 2
+    per = len(d.dropper_positions)
+    return [float(v) for v in st.dropper_length[k * per:(k + 1) * per]]
+
+
+def passage_output(result: PassageResult, p: dict, stem: str, extra: dict | None = None) -> ModelOutput:
+    """Summary (EN 50318 statistics per pantograph, dropper lengths, run info) and writer."""
+    form = result.form
+    summary = {
+        "dropper_lengths_m": central_span_droppers(result),
+        "form_finding_height_error_m": form.height_error_m,
+        "analysis_section_m": list(result.section_m),
+        "elements_per_span": form.structure.elements_per_span,
+        "n_coordinates": int(result.line.n),
+        "simulated_s": result.simulated_s,
+    }
+    rec = result.record
+    if rec is not None:
+        if len(result.statistics) == 1:
+            summary.update(result.statistics[0])
+        else:
+            for k, s in enumerate(result.statistics):
+                summary[f"pantograph_{k + 1}"] = s
+        summary["wall_per_simulated_s"] = rec.stats["wall_s"] / max(result.simulated_s, 1e-12)
+        summary["max_penetration_m"] = float(np.max(rec.penetration_m))
+        if p.get("contact") == "bilateral":
+            summary["max_constraint_violation_m"] = float(np.max(np.abs(rec.penetration_m[1:])))
+        summary["slack_dropper_events"] = int(np.sum(np.diff((rec.dropper_tension_N <= 0).astype(int), axis=0) == 1))
+    summary.update(extra or {})
+    stats = dict(rec.stats) if rec is not None else {}
+    stats["form_finding_wall_s"] = form.wall_s
+
+    def write(out):
+        from .output import plot_passage, write_paraview_series
+
+        files = []
+        if rec is None:
+            return files
+        files.append(rec.save(out / f"{stem}.npz"))
+        files += plot_passage(result, out, stem)
+        if p.get("paraview", True):
+            files.append(write_paraview_series(result, out / "paraview", stem))
+        return files
+
+    return ModelOutput(summary, stats, {"result": result}, write)

@@ -1,0 +1,63 @@
+"""benchmark2015 and en50318 models: summaries, EN 50318 validation at 250 km/h, bad input."""
+import json
+import math
+
+import pytest
+
+from symcat.errors import ParameterError
+from symcat.interaction.statistics import STAT_KEYS
+from symcat.model import run_model
+from symcat.validation import EN50318_RANGES, check, format_table
+
+
+def test_benchmark_static_summary_has_dropper_lengths(tmp_path):
+    res = run_model("benchmark2015", {"t_end": 0.0, "progress": False}, out=tmp_path)
+    lengths = res.summary["dropper_lengths_m"]
+    assert len(lengths) == 9
+    assert lengths == pytest.approx(lengths[::-1], abs=2e-3)
+    assert 0.7 < min(lengths) < max(lengths) < 1.1
+    assert res.summary["form_finding_height_error_m"] < 1e-8
+    assert res.summary["simulated_s"] == 0.0 and "wall_s" in res.summary
+    assert json.loads((tmp_path / "summary.json").read_text())["model"] == "benchmark2015"
+
+
+def test_en50318_at_250_kmh_lands_in_the_contact_force_ranges(tmp_path):
+    """The standard's acceptance check (force statistics; see the issue notes for the uplift)."""
+    res = run_model("en50318", {"speed_kmh": 250.0, "progress": False, "paraview": True}, out=tmp_path)
+    s = res.summary
+    for key in STAT_KEYS:
+        assert key in s and s[key] is not None and math.isfinite(s[key])
+    rows = {r[0]: r for r in check(s, 250)}
+    for key in ("contact_force_mean_N", "contact_force_std_N", "contact_force_stat_max_N",
+                "contact_force_stat_min_N", "contact_force_max_N", "contact_force_min_N", "contact_loss_percent"):
+        assert rows[key][4], f"{key}={rows[key][1]:.4g} outside {rows[key][2]}..{rows[key][3]}"
+    for name in ("en50318_contact_force.png", "en50318_panhead.png", "en50318_uplift_droppers.png", "en50318.npz",
+                 "paraview/en50318.pvd"):
+        assert (tmp_path / name).is_file(), name
+    assert len(list((tmp_path / "paraview").glob("*.vtu"))) > 10
+    from symcat.interaction import load_passage
+
+    arrays = load_passage(tmp_path / "en50318.npz")
+    assert arrays["contact_force_N"].shape == arrays["x_contact_m"].shape
+
+
+def test_validation_table_marks_failures():
+    summary = {k: (lo + hi) / 2 for k, v in EN50318_RANGES.items() for lo, hi in [v[300]]}
+    summary["contact_force_std_N"] = 99.0
+    table = format_table({300: check(summary, 300)})
+    assert "FAIL" in table and "1 quantities outside" in table
+
+
+@pytest.mark.parametrize("model, values, name", [
+    ("benchmark2015", {"speed_kmh": 470.0}, "speed_kmh"),
+    ("benchmark2015", {"dropper_positions_m": "4.5,60"}, "dropper_positions_m"),
+    ("benchmark2015", {"contact_wire_tension_N": -5.0}, "contact_wire_tension_N"),
+    ("benchmark2015", {"presag_scale": 8.0}, "presag"),
+    ("benchmark2015", {"n_pantographs": 2, "n_spans": 8}, "n_spans"),
+    ("en50318", {"speed_kmh": 440.0}, "speed_kmh"),
+])
+def test_bad_input_names_the_parameter_and_writes_nothing(tmp_path, model, values, name):
+    out = tmp_path / "out"
+    with pytest.raises(ParameterError, match=name):
+        run_model(model, {**values, "progress": False}, out=out)
+    assert not out.exists()
