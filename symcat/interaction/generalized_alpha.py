@@ -20,6 +20,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
+from .banded import BandedCholesky
 from .coupled import CoupledLine
 from .recorder import PassageRecorder
 
@@ -60,8 +61,9 @@ class _Stepper:
         self.beta_p = h * h * coef.beta * (1 - a_f) / (1 - a_m)
         self.gamma_p = h * coef.gamma * (1 - a_f) / (1 - a_m)
         k = line.K if stiffness is None else stiffness
-        s = (line.M + self.gamma_p * line.C + self.beta_p * k).tocsc()
-        self.lu = spla.splu(s, permc_spec="MMD_AT_PLUS_A")
+        s = (line.M + self.gamma_p * line.C + self.beta_p * k).tocsr()
+        self.lu = BandedCholesky(s, getattr(line, "_band_permutation", None))
+        line._band_permutation = self.lu.permutation  # same pattern for every step size
 
 
 def integrate(line: CoupledLine, t_end: float, dt: float = 1e-3, rho_inf: float = 0.8, tol: float = 1e-8,
@@ -87,6 +89,14 @@ def integrate(line: CoupledLine, t_end: float, dt: float = 1e-3, rho_inf: float 
     """
     if not dt > 0:
         raise ParameterError(f"dt={dt:g} s: must be > 0")
+    # the banded solves are small: BLAS threads only contend (10x slower on a busy 2-core machine)
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _integrate(line, t_end, dt, rho_inf, tol, max_iterations, record_every, progress, y0, contact_forces0)
+
+
+def _integrate(line, t_end, dt, rho_inf, tol, max_iterations, record_every, progress, y0, contact_forces0):
     if not t_end >= 0:
         raise ParameterError(f"t_end={t_end:g} s: must be >= 0")
     coef = AlphaParameters(rho_inf)
