@@ -213,6 +213,10 @@ def main():
     from bench.dynamics import section as dynamics_section
 
     dynamics = dynamics_section(REPORT)
+    print("pantograph/catenary ...", flush=True)
+    from bench.pantograph import section as pantograph_section
+
+    pantograph = pantograph_section(REPORT)
     lines = [
         "# symcat benchmark report",
         "",
@@ -270,6 +274,8 @@ def main():
         "Target: below 2 s.",
         "",
         *dynamics,
+        "",
+        *pantograph,
     ]
     (REPORT / "README.md").write_text("\n".join(lines))
     print(f"wrote {REPORT / 'README.md'}")

@@ -103,6 +103,10 @@ def test_contact_loss_and_recontact_without_step_collapse(short_line):
     assert res.statistics[0]["contact_loss_percent"] > 0
     assert rec.stats["halvings"] == 0 and rec.iterations.max() <= 12
     assert np.all(f >= 0)
+    # droppers near the pantograph go slack under the uplift wave and take load again
+    slack = rec.dropper_tension_N <= 0
+    assert slack.any() and np.any(np.diff(slack.astype(int), axis=0) == -1)
+    assert not slack[0].any()
     # the bilateral model on the same run must pull (negative force) where the penalty lets go
     bil = _stats(short_line, "bilateral", 0.9 * 459.6, uplift=40.0)
     assert bil.record.contact_force_N[:, 0].min() < 0

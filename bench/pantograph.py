@@ -1,0 +1,101 @@
+"""Pantograph/catenary speed against error: benchmark2015 at 320 km/h.
+
+Statistics against elements per span, time step and Newton tolerance, with the wall time per
+simulated second of each run; the cost growth with the number of spans. Run alone with
+``python -m bench.pantograph`` (writes ``bench/report/pantograph.md``); ``make bench`` includes it.
+"""
+from __future__ import annotations
+
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+from symcat.catenary import benchmark2015, find_form
+from symcat.interaction.passage import run_passage
+from symcat.pantograph import benchmark2015_pantograph
+
+KEYS = ("contact_force_mean_N", "contact_force_std_N", "contact_force_max_N", "contact_force_min_N",
+        "support_uplift_max_m", "contact_loss_percent")
+SPEED = 320 / 3.6
+
+
+def _run(elements=40, dt=5e-4, tol=1e-7, n_spans=10, t_end=None, repeats=1):
+    design = benchmark2015(n_spans)
+    form = find_form(design, elements)
+    walls, res = [], None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        res = run_passage(design, [benchmark2015_pantograph(320)], SPEED, form=form, dt=dt, tol=tol, t_end=t_end,
+                          progress=False)
+        walls.append(time.perf_counter() - t0)
+    wall = statistics.median(walls)
+    stats = res.statistics[0] if res.statistics else {}
+    return stats, wall / res.simulated_s, res
+
+
+def _row(label, stats, ratio, ref):
+    cells = []
+    for k in KEYS:
+        v = stats[k]
+        if k in ("contact_force_std_N", "contact_force_mean_N") and ref is not None:
+            cells.append(f"{v:.2f} ({100 * (v / ref[k] - 1):+.1f} %)")
+        elif k == "support_uplift_max_m":
+            cells.append(f"{1e3 * v:.1f} mm")
+        else:
+            cells.append(f"{v:.2f}")
+    return f"| {label} | " + " | ".join(cells) + f" | {ratio:.2f} |"
+
+
+def section(report_dir: Path) -> list[str]:
+    header = ["| run | mean [N] | std [N] | max [N] | min [N] | uplift | loss [%] | wall / simulated |",
+              "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    mesh = [(e, *_run(elements=e)) for e in (10, 20, 40, 80)]
+    ref = mesh[-1][1]
+    steps = [(dt, *_run(dt=dt)) for dt in (2e-3, 1e-3, 5e-4, 2.5e-4)]
+    ref_dt = steps[-1][1]
+    tols = [(tol, *_run(tol=tol)) for tol in (1e-5, 1e-6, 1e-7, 1e-8)]
+    spans = [(n, *_run(n_spans=n, t_end=0.5, repeats=3)) for n in (10, 20, 40)]
+    lines = [
+        "## Pantograph/catenary: benchmark2015 at 320 km/h (one pantograph, penalty contact)",
+        "",
+        "Statistics of the 20 Hz filtered contact force over spans 5-6 (of 10); in brackets the change "
+        "against the finest run of the same study. Wall time per simulated second of the passage "
+        "(form finding excluded; one run each, the machine is noisy).",
+        "",
+        "### Elements per span (dt 0.5 ms, tol 1e-7 m)",
+        "",
+        *header,
+        *[_row(f"{e} elements/span", s, r, ref) for e, s, r, _ in mesh],
+        "",
+        "### Time step (40 elements/span)",
+        "",
+        *header,
+        *[_row(f"dt {1e3 * dt:g} ms", s, r, ref_dt) for dt, s, r, _ in steps],
+        "",
+        "### Newton tolerance (40 elements/span, dt 0.5 ms)",
+        "",
+        *header,
+        *[_row(f"tol {tol:g} m", s, r, tols[-1][1]) for tol, s, r, _ in tols],
+        "",
+        "### Cost against line length (40 elements/span, dt 0.5 ms, 0.5 s simulated, median of 3)",
+        "",
+        "| spans | coordinates | wall / simulated |",
+        "|---:|---:|---:|",
+        *[f"| {n} | {res.line.n} | {r:.2f} |" for n, s, r, res in spans],
+        "",
+    ]
+    return lines
+
+
+def main() -> None:
+    report = Path(__file__).resolve().parent / "report"
+    report.mkdir(parents=True, exist_ok=True)
+    lines = section(report)
+    (report / "pantograph.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
