@@ -74,8 +74,24 @@ def _solve_wire(body, fixed_nodes, loads, gravity) -> tuple[np.ndarray, np.ndarr
     return result.q.reshape(body.q0.shape), reactions, system
 
 
-def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "cable3d", tol: float = 1e-9,
-              max_iterations: int = 20) -> FormFindingResult:
+def _balance_axial_forces(body, nodes: np.ndarray, reactions_x: np.ndarray, wire) -> None:
+    """Adopt the solved shape and correct each element's stress-free length so that the pins
+    along the line carry no force: element e must then carry the horizontal force of the loads
+    beyond it, so its tension changes by minus the sum of the pin reactions beyond it. Without
+    the pins the wire then keeps its stations and the droppers hang vertically, as installed
+    (otherwise the sag-induced shortening piles up span after span along a long section)."""
+    names = body.element.param_names
+    chord = np.linalg.norm(np.diff(nodes[:, :3], axis=0), axis=1)
+    cos = np.abs(np.diff(nodes[:, 0])) / chord
+    beyond = np.cumsum(reactions_x[::-1])[::-1][1:]  # sum over nodes e+1..N
+    col = names.index("prestrain")
+    body.params[:, col] += -beyond / (wire.EA * cos)
+    body.params[:, names.index("rho")] = wire.mass_per_length * (1 + body.params[:, col]) / body.params[:, names.index("A")]
+    body.q0[:] = nodes
+
+
+def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "cable3d", tol: float = 1e-8,
+              max_iterations: int = 30) -> FormFindingResult:
     """Dropper lengths and static equilibrium for ``design`` (see the module docstring).
 
     Raises
@@ -99,8 +115,9 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
     for iteration in range(1, max_iterations + 1):
         half = 0.5 * d.dropper_mass_per_length * length0 * d.gravity
         # 1. contact wire held at the design height at droppers and supports
-        fixed = [(0, ["x", "y", "z"] + beam_extra), (n_nodes - 1, ["y", "z"])]
-        fixed += [(k, ["y", "z"]) for k in inner] + [(k, ["z"]) for k in drop]
+        fixed = [(0, ["x", "y", "z"] + beam_extra), (n_nodes - 1, ["x", "y", "z"])]
+        fixed += [(k, ["x", "y", "z"]) for k in inner] + [(k, ["x", "z"]) for k in drop]
+        fixed += [(k, ["x"]) for k in np.setdiff1d(np.arange(1, n_nodes - 1), np.concatenate([inner, drop]))]
         loads = [(n_nodes - 1, (d.contact_wire.tension, 0.0, 0.0))]
         for k, node in enumerate(drop):
             w = -(d.clamp_mass_contact * d.gravity + half[k])
@@ -116,7 +133,8 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
                 f"presag: the target needs the dropper at x={d.dropper_x()[k]:g} m in compression "
                 f"(tension {tension[k]:.1f} N); reduce the presag or its curvature")
         # 2. messenger under the dropper tensions
-        fixed = [(0, ["x", "y", "z"] + beam_extra), (n_nodes - 1, ["y", "z"])] + [(k, ["y", "z"]) for k in inner]
+        fixed = [(0, ["x", "y", "z"] + beam_extra), (n_nodes - 1, ["x", "y", "z"])] + [(k, ["x", "y", "z"]) for k in inner]
+        fixed += [(k, ["x"]) for k in np.setdiff1d(np.arange(1, n_nodes - 1), inner)]
         loads = [(n_nodes - 1, (d.messenger_wire.tension, 0.0, 0.0))]
         for k, node in enumerate(drop):
             w = -(d.clamp_mass_messenger * d.gravity + half[k])
@@ -140,8 +158,8 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
             raise ParameterError("dropper_stiffness: a dropper stretches beyond its own length; increase it")
         last_change = np.max(np.abs(new_length0 - length0))
         length0 = new_length0
-        st.contact.q0[:] = cw
-        st.messenger.q0[:] = mw
+        _balance_axial_forces(st.contact, cw, cw_react[:, 0], d.contact_wire)
+        _balance_axial_forces(st.messenger, mw, mw_react[:, 0], d.messenger_wire)
         st.mw_supports.preload = mw_react[inner, 2].copy()
         st.cw_supports.preload = cw_react[inner, 2].copy()
         if last_change < tol:

@@ -95,6 +95,16 @@ def test_dropper_lengths_symmetric_and_plausible(form):
     assert 0.6 < span.min() < span.max() < 1.2  # encumbrance 1.2 m, presag 55 mm
 
 
+def test_long_section_keeps_droppers_vertical():
+    """Over a 1.1 km tension section the wires keep their stations (no drift of the messenger
+    against the contact wire), so every span gets the same droppers."""
+    form = find_form(benchmark2015(n_spans=20), 10)
+    e, _, _ = form.structure.dropper_state(form.q)
+    assert np.abs(e[:, 0]).max() < 1e-6
+    lengths = form.dropper_length_m.reshape(20, 9)
+    np.testing.assert_allclose(lengths[2:-2], np.broadcast_to(lengths[10], (16, 9)), atol=1e-4)
+
+
 def test_beam_elements_give_the_same_form():
     cable = find_form(benchmark2015(n_spans=3), 10)
     beam = find_form(benchmark2015(n_spans=3), 10, element="beam3d")
