@@ -23,6 +23,7 @@ import numpy as np
 from ..codegen.library import kernel_library, library_interface
 from ..errors import ParameterError
 from ..scene.ancf import AncfBody
+from ..scene.contact import PenaltyContact
 from ..scene.forces import PointLoad, RotationalSpring, SpringDamper
 from ..scene.joints import Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical, perpendiculars, unit
 from ..scene.rigid import RigidBody
@@ -89,6 +90,7 @@ class MultibodyModel:
         self.groups: dict[str, KernelGroup] = {}
         self.force_groups: dict[str, KernelGroup] = {}
         self.sliding: list[Sliding] = []
+        self.contacts: list[Sliding] = []   # penalty contacts (same window bookkeeping)
         self.row_names: list[str] = []
         for body in scene.rigid_bodies:
             self._add("normalization_rigid", body.name, [Side("rigid", self._rigid_indices(body.name), body)], {})
@@ -98,7 +100,9 @@ class MultibodyModel:
             self._add_force(force)
         self.n_s = len(self.sliding)
         self.s0 = np.array([sl.joint.s0 for sl in self.sliding])
-        for sl in self.sliding:
+        self.n_sc = len(self.contacts)
+        self.sc0 = np.array([ct.joint.s0 for ct in self.contacts])
+        for sl in self.sliding + self.contacts:
             self.set_window(sl, sl.joint.s0)
         self._group_rows()
 
@@ -212,11 +216,15 @@ class MultibodyModel:
         sl.window = new
         return moved
 
+    def windowed(self) -> list[Sliding]:
+        """Sliding joints, then contacts: everything that has an element window."""
+        return self.sliding + self.contacts
+
     def window_margin(self, s: np.ndarray) -> float:
-        """Smallest distance, in elements, from any sliding point to the edge of its window
-        (a wire end counts as no edge)."""
+        """Smallest distance, in elements, from any sliding or contact point (``s`` in the order
+        of :meth:`windowed`) to the edge of its window (a wire end counts as no edge)."""
         margin = np.inf
-        for sl, s_k in zip(self.sliding, s):
+        for sl, s_k in zip(self.windowed(), s):
             lo, hi = sl.window
             n_el = len(sl.element_start) - 1
             length = sl.element_start[1] - sl.element_start[0]
@@ -227,6 +235,11 @@ class MultibodyModel:
         return margin
 
     def _add_force(self, force):
+        if isinstance(force, PenaltyContact):
+            from .contact import add_contact
+
+            self.contacts.append(add_contact(self, force))
+            return
         if isinstance(force, PointLoad):
             body = self.scene.find(force.body)
             side = self.side(force.body, body.position if force.at is None else force.at)

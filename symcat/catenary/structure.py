@@ -149,6 +149,7 @@ class CatenaryStructure:
         self.cw_zx = idx(self.contact, range(self.contact.n_nodes), "z_x")
         self._lumped = self._lumped_masses()
         q = ca.MX.sym("q", self.n)
+        self._linear = None
         self._f_int = BufferedFunction(ca.Function("catenary_internal", [q], [ca.densify(self.system.internal_force(q))]))
         self._k_int = ca.Function("catenary_stiffness", [q], [self.system.tangent_stiffness(q)])
         self._f_ext = self.system.external_force_value(self.system.dofs.q0) - self._lumped * d.gravity * self._z_mask()
@@ -211,7 +212,7 @@ class CatenaryStructure:
     def forces(self, q: np.ndarray, v: np.ndarray | None = None) -> np.ndarray:
         """Total generalized force (N) on the catenary except contact and Rayleigh damping:
         wire elasticity, gravity, end tensions, droppers and support springs."""
-        f = self._f_int(q) + self._f_ext
+        f = (self._f_int(q) if self._linear is None else self._linear(q)) + self._f_ext
         e, _, tension = self.dropper_state(q, v)
         ft = tension[:, None] * e
         ia, ib = self.cw_xyz[self.dropper_nodes], self.mw_xyz[self.dropper_nodes]
@@ -225,7 +226,7 @@ class CatenaryStructure:
     def stiffness(self, q: np.ndarray, droppers_taut: bool | None = None) -> sps.csc_matrix:
         """Tangent stiffness ``-d forces / d q`` (sparse). ``droppers_taut=True`` counts every
         dropper as taut (the iteration matrix of a dynamic run); default: the current state."""
-        k = to_scipy(self._k_int(q)).tocoo()
+        k = (to_scipy(self._k_int(q)) if self._linear is None else self._k_lin).tocoo()
         rows, cols, vals = [k.row], [k.col], [k.data]
         e, length, tension = self.dropper_state(q)
         kd = self.dropper_stiffness()
@@ -243,6 +244,23 @@ class CatenaryStructure:
             iz = xyz[sup.nodes, 2]
             rows.append(iz), cols.append(iz), vals.append(np.full(iz.size, sup.stiffness))
         return sps.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(self.n, self.n))
+
+    def linearize_wires(self, q_ref: np.ndarray | None) -> None:
+        """Replace the wires' nonlinear elastic forces by their linearization about ``q_ref``
+        (typically the static equilibrium), ``f(q_ref) - K(q_ref) (q - q_ref)``; droppers,
+        supports and contact stay nonlinear. ``None`` restores the nonlinear wires.
+
+        Around a static catenary the wires move by centimetres, so this is the usual model of
+        the field; comparing both tells the size of the geometric nonlinearity.
+        """
+        if q_ref is None:
+            self._linear = None
+            return
+        q_ref = np.array(q_ref, dtype=float)
+        f_ref = self._f_int(q_ref)
+        k_ref = to_scipy(self._k_int(q_ref)).tocsr()
+        self._k_lin = k_ref
+        self._linear = lambda q: f_ref - k_ref @ (q - q_ref)
 
     @property
     def mass_matrix(self) -> sps.csc_matrix:

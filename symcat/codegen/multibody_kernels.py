@@ -11,6 +11,19 @@ of seed eq. 14, including the time terms of driving constraints).
 
 Force library ``<f>``: ``<f>(y, y_dot, t, p) -> q`` (generalized force on ``y``).
 
+Contact library ``contact_<el>_rigid`` with ``y = [e, x_j, s]`` (see
+:mod:`symcat.symbolic.contact`): ``<c>_tangency(y, p) -> T``; ``<c>_force(y, y_dot, p) -> q, gap, f``
+with ``y_dot`` the rates of ``[e, x_j]`` (``s_dot`` follows from the tangency condition),
+``q`` the generalized force on ``[e, x_j]``, ``gap`` (m, > 0 when separated) and the normal
+force ``f`` (N, >= 0). The penalty law is C1 (IDAS sees no kink at contact loss or re-contact)
+and exactly zero once separated, with the smoothing depth ``delta`` (m)::
+
+    ramp_d(x) = 0 (x <= 0),  x^2 / (2 d) (0 < x < d),  x - d / 2 (x >= d)
+    pen = -gap,  w = smoothstep(pen / delta)               (damping only in contact)
+    f = ramp_f0(k ramp_delta(pen) + c w pen_dot),  f0 = k delta   (never pulling)
+
+so ``f = k (pen - delta) + c pen_dot`` in contact, once ``pen > 2 delta``.
+
 Every function ships its ``jac_`` companion, so that CasADi differentiates through them with
 compiled code (IDAS needs the derivatives of ``c_y^T lambda`` and ``q_d``).
 """
@@ -18,6 +31,7 @@ from __future__ import annotations
 
 import casadi as ca
 
+from ..symbolic.contact import CONTACTS
 from ..symbolic.force_elements import FORCES
 from ..symbolic.joints import CONSTRAINTS
 from ..symbolic.rigid import rigid_body
@@ -85,8 +99,44 @@ def force_functions(name: str) -> list[ca.Function]:
     return _with_jacobian(ca.Function(name, [y, y_dot, t, p], [q], ["y", "y_dot", "t", "p"], ["q"], OPTS))
 
 
+CONTACT_LAW = ("k", "c", "delta")
+
+
+def _ramp(x, d):
+    """C1 ramp: 0 below 0, quadratic up to ``d``, then ``x - d / 2``."""
+    return ca.if_else(x <= 0, 0, ca.if_else(x < d, x**2 / (2 * d), x - d / 2))
+
+
+def _smoothstep(x):
+    """C1 step from 0 (x <= 0) to 1 (x >= 1)."""
+    t = ca.fmin(ca.fmax(x, 0), 1)
+    return t**2 * (3 - 2 * t)
+
+
+def contact_functions(name: str) -> list[ca.Function]:
+    defn = CONTACTS[name]()
+    ny = defn.y.rows
+    y, y_dot = ca.SX.sym("y", ny), ca.SX.sym("y_dot", ny - 1)
+    p = ca.SX.sym("p", defn.p.rows + len(CONTACT_LAW))
+    conv = SympyToCasadi({**bind(defn.y, y), **bind(defn.p, p[: defn.p.rows])})
+    k, c, delta = (p[defn.p.rows + i] for i in range(len(CONTACT_LAW)))
+    tangency, gap, d, normal = conv(defn.tangency), conv(defn.gap), conv(defn.d), conv(defn.normal)
+    t_y, g_y = ca.gradient(tangency, y), ca.gradient(gap, y)
+    s_dot = -ca.dot(t_y[: ny - 1], y_dot) / t_y[ny - 1]
+    pen_dot = -(ca.dot(g_y[: ny - 1], y_dot) + g_y[ny - 1] * s_dot)
+    pen = -gap
+    f_raw = k * _ramp(pen, delta) + c * _smoothstep(pen / delta) * pen_dot
+    force = _ramp(f_raw, k * delta)
+    q = force * ca.mtimes(ca.jacobian(d, y[: ny - 1]).T, normal)
+    return [
+        *_with_jacobian(ca.Function(f"{name}_tangency", [y, p], [tangency], ["y", "p"], ["T"], OPTS)),
+        *_with_jacobian(ca.Function(f"{name}_force", [y, y_dot, p], [q, gap, force], ["y", "y_dot", "p"],
+                                    ["q", "gap", "f"], OPTS)),
+    ]
+
+
 def multibody_library_names() -> list[str]:
-    return ["rigid", *sorted(CONSTRAINTS), *sorted(FORCES)]
+    return ["rigid", *sorted(CONSTRAINTS), *sorted(FORCES), *sorted(CONTACTS)]
 
 
 def multibody_functions(name: str) -> list[ca.Function]:
@@ -96,6 +146,8 @@ def multibody_functions(name: str) -> list[ca.Function]:
         return constraint_functions(name)
     if name in FORCES:
         return force_functions(name)
+    if name in CONTACTS:
+        return contact_functions(name)
     raise KeyError(name)
 
 
@@ -105,6 +157,10 @@ def interface(name: str) -> dict:
         from ..symbolic.rigid import RIGID_PARAMS
 
         return {"kind": "rigid", "params": [n for n, _, _ in RIGID_PARAMS]}
+    if name in CONTACTS:
+        defn = CONTACTS[name]()
+        return {"kind": "contact", "params": defn.param_names + list(CONTACT_LAW), "n_i": defn.e.rows,
+                "n_j": defn.x_j.rows, "n_s": 1}
     defn = CONSTRAINTS[name]() if name in CONSTRAINTS else FORCES[name]()
     out = {"kind": "constraint" if name in CONSTRAINTS else "force", "params": defn.param_names,
            "n_i": defn.x_i.rows, "n_j": defn.x_j.rows}

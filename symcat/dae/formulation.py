@@ -20,6 +20,10 @@ embedded, GGL
     x = [q, v], z = [a, s, lambda_n, mu];  q' = v + H^T mu;
     0 = M a + H^T lambda_n - Q,  0 = C_T,  0 = C_R,  0 = H v + C_Rt.
 
+Penalty contacts (:class:`symcat.scene.PenaltyContact`) add, in every form, algebraic arc lengths
+``s_c`` (z block ``sc``) with the tangency equations ``0 = T(q, s_c)`` (no multiplier, seed
+Section 8) and their normal forces to ``Q``.
+
 Accelerations and multipliers are algebraic; the driver keeps them out of IDAS's error test.
 """
 from __future__ import annotations
@@ -30,6 +34,7 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sps
 
+from ..assembly.contact import contact_terms
 from ..assembly.multibody import MultibodyModel
 from ..assembly.sparse import to_casadi_sparse
 from ..errors import ParameterError
@@ -87,6 +92,7 @@ class Formulation:
         q_fixed[model.free] = 0.0
         self.q_fixed = ca.DM(q_fixed)
         self.n_s, self.n_c = model.n_s, model.n_c
+        self.n_sc = model.n_sc
         tang = model.tangency_rows
         self.rows_t = tang
         self.rows_r = [r for r in range(self.n_c) if r not in set(tang)]
@@ -116,24 +122,33 @@ class Formulation:
         return y if self._transform is None else self._transform[0] @ y
 
     # --- shared pieces ------------------------------------------------------------------------
-    def terms(self, q_f, v_f, s, w, t):
-        """Mass matrix, forces and constraint terms in free coordinates (MX)."""
+    def terms(self, q_f, v_f, s, w, t, sc=None):
+        """Mass matrix, forces and constraint terms in free coordinates (MX); ``sc`` are the
+        contact arc lengths (required when the model has penalty contacts)."""
         m = self.model
         q = self.q_fixed + ca.mtimes(self.P, q_f)
         v = ca.mtimes(self.P, v_f)
         c = m.constraints(q, v, s, w, t)
         mass = ca.mtimes(self.P.T, ca.mtimes(m.mass_matrix(q), self.P))
-        force = ca.mtimes(self.P.T, m.forces(q, v, t))
+        f = m.forces(q, v, t)
+        out = {"T": ca.MX(0, 1), "gap": ca.MX(0, 1), "fc": ca.MX(0, 1)}
+        if self.n_sc:
+            if sc is None:
+                raise ValueError("terms: the model has penalty contacts; pass their arc lengths sc")
+            ct = contact_terms(m, q, v, sc)
+            f += ct["Q"]
+            out = {"T": ct["T"], "gap": ct["gap"], "fc": ct["force"]}
+        force = ca.mtimes(self.P.T, f)
         return {"q": q, "v": v, "M": mass, "Q": force, "C": c["c"], "Cq": ca.mtimes(c["c_q"], self.P),
-                "Cs": c["c_s"], "Ct": c["c_t"], "Qd": c["q_d"]}
+                "Cs": c["c_s"], "Ct": c["c_t"], "Qd": c["q_d"], **out}
 
-    def embedded_terms(self, q_f, v_f, s, t):
+    def embedded_terms(self, q_f, v_f, s, t, sc=None):
         """``s_dot`` from the tangency rows, then ``H``, ``Q_cn`` and the reduced constraint terms."""
-        probe = self.terms(q_f, v_f, s, ca.MX.zeros(self.n_s), t)
+        probe = self.terms(q_f, v_f, s, ca.MX.zeros(self.n_s), t, sc)
         tr, rr = self.rows_t, self.rows_r
         c_ts = ca.diag(probe["Cs"][tr, :])           # one s per tangency row
         s_dot = -ca.mtimes(probe["Cq"][tr, :], v_f) / c_ts
-        k = self.terms(q_f, v_f, s, s_dot, t)
+        k = self.terms(q_f, v_f, s, s_dot, t, sc)
         c_rs = k["Cs"][rr, :]
         inv = 1 / ca.diag(k["Cs"][tr, :])
         h = k["Cq"][rr, :] - ca.mtimes(c_rs, ca.mtimes(ca.diag(inv), k["Cq"][tr, :]))
@@ -152,6 +167,7 @@ class Formulation:
         else:
             x = [("q", n_f), ("v", n_f)]
             z = [("a", n_f), ("s", n_s), ("lambda", n_r)] + ([("mu", n_r)] if self.index == "ggl" else [])
+        z += [("sc", self.n_sc)] if self.n_sc else []
         return _layout(x), _layout(z)
 
     def dae(self) -> dict:
@@ -165,9 +181,10 @@ class Formulation:
         X = {k: x[b.slice] for k, b in xb.items()}
         Z = {k: z[b.slice] for k, b in zb.items()}
         al = be = self.baumgarte
+        sc = Z.get("sc")
         if self.formulation == "augmented":
             w = X["w"] if self.index == "1" else Z["w"]
-            k = self.terms(X["q"], X["v"], X["s"], w, t)
+            k = self.terms(X["q"], X["v"], X["s"], w, t, sc)
             dyn = ca.mtimes(k["M"], Z["a"]) + ca.mtimes(k["Cq"].T, Z["lambda"]) - k["Q"]
             free_s = ca.mtimes(k["Cs"].T, Z["lambda"])
             c_dot = ca.mtimes(k["Cq"], X["v"]) + ca.mtimes(k["Cs"], w) + k["Ct"]
@@ -179,7 +196,7 @@ class Formulation:
                 ode = ca.vertcat(X["v"] + ca.mtimes(k["Cq"].T, Z["mu"]), w + ca.mtimes(k["Cs"].T, Z["mu"]), Z["a"])
                 alg = ca.vertcat(dyn, free_s, k["C"], c_dot)
         else:
-            k = self.embedded_terms(X["q"], X["v"], Z["s"], t)
+            k = self.embedded_terms(X["q"], X["v"], Z["s"], t, sc)
             dyn = ca.mtimes(k["M"], Z["a"]) + ca.mtimes(k["H"].T, Z["lambda"]) - k["Q"]
             if self.index == "1":
                 acc = ca.mtimes(k["H"], Z["a"]) + k["Qcn"] + 2 * al * k["CRdot"] + be**2 * k["CR"]
@@ -188,10 +205,15 @@ class Formulation:
             else:
                 ode = ca.vertcat(X["v"] + ca.mtimes(k["H"].T, Z["mu"]), Z["a"])
                 alg = ca.vertcat(dyn, k["CT"], k["CR"], k["CRdot"])
+        alg = ca.vertcat(alg, k["T"])
         return {"x": x, "z": z, "p": t0, "t": t_rel, "ode": ode, "alg": alg}
 
     def residual_names(self) -> list[str]:
         """Names of the algebraic residual rows (for failure reports)."""
+        contacts = [f"tangency of contact {ct.joint.name}" for ct in self.model.contacts]
+        return self._residual_names() + contacts
+
+    def _residual_names(self) -> list[str]:
         coords = [self.model.coordinate_names()[i] for i in self.model.free]
         rows = self.model.row_names
         sliding = [sl.joint.name for sl in self.model.sliding]

@@ -21,9 +21,24 @@ from .formulation import Formulation
 def _terms_function(form: Formulation) -> ca.Function:
     n_f, n_s = form.n_f, form.n_s
     q, v, s, w, t = ca.MX.sym("q", n_f), ca.MX.sym("v", n_f), ca.MX.sym("s", n_s), ca.MX.sym("w", n_s), ca.MX.sym("t")
-    k = form.terms(q, v, s, w, t)
-    names = ["C", "Cq", "Cs", "Ct", "Qd", "M", "Q"]
-    return ca.Function("terms", [q, v, s, w, t], [k[n] for n in names], ["q", "v", "s", "w", "t"], names)
+    sc = ca.MX.sym("sc", form.n_sc)
+    k = form.terms(q, v, s, w, t, sc)
+    names = ["C", "Cq", "Cs", "Ct", "Qd", "M", "Q", "T"]
+    outs = [k[n] for n in names] + [ca.diag(ca.jacobian(k["T"], sc)) if form.n_sc else ca.MX(0, 1)]
+    return ca.Function("terms", [q, v, s, w, t, sc], outs, ["q", "v", "s", "w", "t", "sc"], names + ["T_sc"])
+
+
+def locate_contacts(fn: ca.Function, q, v, s, w, t, sc, tol: float = 1e-12, max_iterations: int = 50) -> np.ndarray:
+    """Contact arc lengths solving the tangency conditions for given coordinates (scalar Newton
+    per contact; each tangency depends on its own arc length only)."""
+    sc = np.array(sc, dtype=float)
+    for _ in range(max_iterations):
+        out = fn(q, v, s, w, t, sc)
+        res, slope = np.asarray(out[7]).ravel(), np.asarray(out[8]).ravel()
+        if np.abs(res).max(initial=0.0) <= tol:
+            return sc
+        sc = sc - res / slope
+    raise SolverError(f"the contact points could not be located on their wires (tangency residual {np.abs(res).max():.3g} m)")
 
 
 def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max_iterations: int = 30):
@@ -42,10 +57,11 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     w = np.zeros(form.n_s)
     names = model.row_names
     n_f = form.n_f
+    sc = model.sc0.copy()
 
     def evaluate(q, v, s, w):
-        out = fn(q, v, s, w, t0)
-        c, cq, cs, ct, qd, m, f = out
+        out = fn(q, v, s, w, t0, sc)
+        c, cq, cs, ct, qd, m, f = out[:7]
         return (np.asarray(c).ravel(), sps.hstack([to_scipy(cq), to_scipy(ca.DM(cs))]).tocsc(),
                 np.asarray(ct).ravel(), np.asarray(qd).ravel(), to_scipy(m), np.asarray(f).ravel(),
                 to_scipy(ca.DM(cq)), np.asarray(ca.densify(cs)))
@@ -73,6 +89,8 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
         u_dot = np.r_[v, w]
         u_dot -= w_inv @ (jac.T @ _solve(jac @ w_inv @ jac.T, jac @ u_dot + ct))
         v, w = u_dot[:n_f], u_dot[n_f:]
+    if form.n_sc:
+        sc = locate_contacts(fn, q, v, s, w, t0, sc)
     c, jac, ct, qd, m, f, cq, cs = evaluate(q, v, s, w)
     xb, zb = form.blocks()
     x0 = np.zeros(sum(b.size for b in xb.values()))
@@ -80,7 +98,7 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     if form.formulation == "augmented":
         a, s_dd, lam = kkt_solve(m, f, cq, cs, qd)
         values_x = {"q": q, "s": s, "v": v, "w": w}
-        values_z = {"a": a, "s_dd": s_dd, "w": w, "lambda": lam, "mu": np.zeros(form.n_c)}
+        values_z = {"a": a, "s_dd": s_dd, "w": w, "lambda": lam, "mu": np.zeros(form.n_c), "sc": sc}
     else:
         tr, rr = form.rows_t, form.rows_r
         cq_d = cq.toarray() if form.n_s else cq
@@ -93,7 +111,7 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
         kkt = sps.bmat([[m, h.T], [h, None]], format="csc")
         sol = _solve(kkt, np.r_[f, -q_cn])
         values_x = {"q": q, "v": v}
-        values_z = {"a": sol[:n_f], "s": s, "lambda": sol[n_f:], "mu": np.zeros(len(rr))}
+        values_z = {"a": sol[:n_f], "s": s, "lambda": sol[n_f:], "mu": np.zeros(len(rr)), "sc": sc}
     for name, b in xb.items():
         x0[b.slice] = values_x[name]
     for name, b in zb.items():

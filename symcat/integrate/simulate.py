@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
+import scipy.sparse.linalg as spla
 
 from ..assembly.multibody import MultibodyModel
 from ..dae.formulation import Formulation
@@ -49,6 +50,11 @@ class SimulationResult:
         Max-norm of ``C`` and of ``C_q v + C_s s_dot + C_t``.
     stats : dict
         IDAS statistics summed over chunks, restarts, wall time.
+    a : ndarray (n_t, n_q)
+        Accelerations (m/s^2, 1/s^2), from the same KKT solve as the multipliers.
+    contacts : dict
+        Penalty contact name -> ``{"s_m", "gap_m", "force_N"}`` histories (n_t,): arc length,
+        normal gap (> 0 separated) and normal force.
     """
 
     t_s: np.ndarray
@@ -64,6 +70,8 @@ class SimulationResult:
     position_drift: np.ndarray | None = None
     velocity_drift: np.ndarray | None = None
     stats: dict = field(default_factory=dict)
+    a: np.ndarray | None = None
+    contacts: dict = field(default_factory=dict)
 
     def coordinate(self, name: str) -> np.ndarray:
         """History of one coordinate, e.g. ``"wire[3].z"`` or ``"body.x"``."""
@@ -76,6 +84,8 @@ class SimulationResult:
                   "velocity_drift": self.velocity_drift,
                   **{f"energy_{k}_J": v for k, v in self.energy_J.items()},
                   **{f"reaction_{k}_N": v for k, v in self.reactions_N.items()},
+                  **{f"contact_{k}_{n}": v for k, c in self.contacts.items() for n, v in c.items()},
+                  **({"a": self.a} if self.a is not None else {}),
                   "coordinate_names": np.array(self.coordinate_names), "row_names": np.array(self.row_names)}
         np.savez_compressed(path, **arrays)
 
@@ -95,7 +105,9 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     formulation, index : str
         ``augmented``/``embedded`` and ``1``/``ggl`` (see :mod:`symcat.dae.formulation`).
     rtol, atol : float
-        IDAS tolerances (differential states only).
+        IDAS tolerances (differential states only). ``atol`` may also be an array over all
+        generalized coordinates (``model.coordinate_names()``), used for the coordinates and
+        their velocities (e.g. looser on the stiff cross-section gradients of a thin beam).
     n_out : int
         Output intervals.
     baumgarte : float
@@ -135,7 +147,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     # absolute tolerance still weighs IDAS's Newton convergence test: with the differential
     # atol, GGL's mu (identically ~0) can never "converge" and IDAS reports IDA_CONV_FAIL.
     n_x, n_z = len(x), len(z)
-    opts = {"reltol": rtol, "abstolv": [atol] * n_x + [algebraic_atol] * n_z, "suppress_algebraic": True,
+    opts = {"reltol": rtol, "abstolv": _atol_vector(form, atol) + [algebraic_atol] * n_z, "suppress_algebraic": True,
             "calc_ic": False, "max_num_steps": int(max_steps), "linear_solver": linear_solver}
     if max_step:
         opts["max_step_size"] = max_step
@@ -164,7 +176,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             try:
                 out = integ(x0=x, z0=z, p=t_grid[a])
             except RuntimeError as exc:
-                if b - a > 1 and model.sliding:
+                if b - a > 1 and model.windowed():
                     # Possibly a sliding point left its window: retry shorter before giving up.
                     stats["retries"] = stats.get("retries", 0) + 1
                     limit = max(1, (b - a) // 2)
@@ -196,6 +208,22 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     return _result(form, t_grid, xs, zs, stats, wall0)
 
 
+def _atol_vector(form, atol) -> list:
+    """Absolute tolerances of the differential states from a scalar or a per-coordinate array."""
+    xb, _ = form.blocks()
+    n_x = sum(b.size for b in xb.values())
+    per = np.atleast_1d(np.asarray(atol, dtype=float))
+    if per.size == 1:
+        return [float(per[0])] * n_x
+    if per.size != form.model.n_q:
+        raise ParameterError(f"atol: give a number or {form.model.n_q} values (one per coordinate), not {per.size}")
+    free = per[form.model.free] if not form.cholesky else np.full(form.n_f, per.min())
+    out = np.full(n_x, per.min())
+    for name in ("q", "v"):
+        out[xb[name].slice] = free
+    return out.tolist()
+
+
 def _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges) -> int:
     """End (output index) of the next integrator call: about 10 % of the run for progress, and
     short enough that no sliding point travels more than a quarter of its window (the window
@@ -205,9 +233,9 @@ def _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges) -> int:
         return int(fixed_edges[np.searchsorted(fixed_edges, a, side="right")])
     dt = t_grid[1] - t_grid[0]
     span = max(1, int(round(0.1 * n_out)))
-    if model.sliding:
+    if model.windowed():
         s_dot = np.abs(_s_dot(form, x, z))
-        for sl, v in zip(model.sliding, s_dot):
+        for sl, v in zip(model.windowed(), s_dot):
             lo, hi = sl.window
             if lo == 0 and hi == len(sl.element_start) - 1:
                 continue  # the window is the whole wire
@@ -219,10 +247,10 @@ def _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges) -> int:
 
 def _left_window(model, form, x, z) -> bool:
     """True if a sliding point lies outside its window (wire ends excepted)."""
-    if not model.sliding:
+    if not model.windowed():
         return False
-    s = _split(form, x, z)["s"]
-    for sl, s_k in zip(model.sliding, s):
+    s = _window_s(form, x, z)
+    for sl, s_k in zip(model.windowed(), s):
         lo, hi = sl.window
         n_el = len(sl.element_start) - 1
         if (lo > 0 and s_k < sl.element_start[lo]) or (hi < n_el and s_k > sl.element_start[hi]):
@@ -231,21 +259,28 @@ def _left_window(model, form, x, z) -> bool:
 
 
 def _s_dot(form, x, z) -> np.ndarray:
+    """Rates of the windowed arc lengths (sliding joints, then contacts)."""
     parts = _split(form, x, z)
-    if "w" in parts:
-        return parts["w"]
-    # Embedded form: s is algebraic; the largest velocity bounds s_dot well enough here.
-    return np.full(form.n_s, np.abs(parts["v"]).max(initial=0.0))
+    # Algebraic arc lengths (embedded form, contacts): the largest velocity bounds s_dot well enough here.
+    bound = np.abs(parts["v"]).max(initial=0.0)
+    sliding = parts["w"] if "w" in parts else np.full(form.n_s, bound)
+    return np.r_[sliding, np.full(form.n_sc, bound)]
+
+
+def _window_s(form, x, z) -> np.ndarray:
+    """Arc lengths of the sliding joints, then of the contacts."""
+    parts = _split(form, x, z)
+    return np.r_[parts["s"], parts.get("sc", np.zeros(0))]
 
 
 def _update_windows(model, form, x, z) -> bool:
-    if not model.sliding:
+    if not model.windowed():
         return False
-    s = _split(form, x, z)["s"]
+    s = _window_s(form, x, z)
     if model.window_margin(s) >= 2:
         return False
     moved = False
-    for sl, s_k in zip(model.sliding, s):
+    for sl, s_k in zip(model.windowed(), s):
         moved |= model.set_window(sl, s_k)
     return moved
 
@@ -282,7 +317,7 @@ def _dependent_rows(form, x, z, t) -> str:
     parts = _split(form, x, z)
     n_s = form.n_s
     qs, vs, ss, ws = ca.MX.sym("q", form.n_f), ca.MX.sym("v", form.n_f), ca.MX.sym("s", n_s), ca.MX.sym("w", n_s)
-    k = form.terms(qs, vs, ss, ws, ca.MX(t))
+    k = form.terms(qs, vs, ss, ws, ca.MX(t), ca.MX.sym("sc", form.n_sc))
     jac = ca.Function("j", [qs, vs, ss, ws], [ca.horzcat(k["Cq"], k["Cs"])])
     j = np.asarray(ca.densify(jac(parts["q"], parts["v"], parts["s"], parts.get("w", np.zeros(n_s)))))
     u, sv, _ = np.linalg.svd(j, full_matrices=False)
@@ -296,13 +331,13 @@ def _dependent_rows(form, x, z, t) -> str:
 def _result(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
     model = form.model
     # Post-processing sees the whole wire: the integration windows have moved on.
-    saved = [sl.window for sl in model.sliding]
-    for sl in model.sliding:
+    saved = [sl.window for sl in model.windowed()]
+    for sl in model.windowed():
         sl.window = (0, len(sl.element_start) - 1)
     try:
         return _collect(form, t, xs, zs, stats, wall0)
     finally:
-        for sl, w in zip(model.sliding, saved):
+        for sl, w in zip(model.windowed(), saved):
             sl.window = w
 
 
@@ -318,32 +353,42 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
     s = np.array([p["s"] for p in parts]).reshape(len(parts), n_s)
     qs, vs = ca.MX.sym("q", n_f), ca.MX.sym("v", n_f)
     ss, ws, ts = ca.MX.sym("s", n_s), ca.MX.sym("w", n_s), ca.MX.sym("t")
+    scs = ca.MX.sym("sc", form.n_sc)
     if form.formulation == "embedded" and n_s:
-        k = form.embedded_terms(qs, vs, ss, ts)
+        k = form.embedded_terms(qs, vs, ss, ts, scs)
         s_dot_expr = k["s_dot"]
     else:
         s_dot_expr = ws
-    kk = form.terms(qs, vs, ss, s_dot_expr, ts)
+    kk = form.terms(qs, vs, ss, s_dot_expr, ts, scs)
     qf = form.q_fixed + ca.mtimes(form.P, qs)
     vf = ca.mtimes(form.P, vs)
     energy = ca.Function("e", [qs, vs], [model.kinetic_energy(qf, vf), model.potential_energy(qf)])
-    drift = ca.Function("d", [qs, vs, ss, ws, ts], [kk["C"], ca.mtimes(kk["Cq"], vs) + ca.mtimes(kk["Cs"], s_dot_expr) + kk["Ct"],
-                                                   s_dot_expr, kk["Cq"], kk["Cs"], kk["M"], kk["Q"], kk["Qd"]])
+    drift = ca.Function("d", [qs, vs, ss, ws, ts, scs], [kk["C"], ca.mtimes(kk["Cq"], vs) + ca.mtimes(kk["Cs"], s_dot_expr) + kk["Ct"],
+                                                        s_dot_expr, kk["Cq"], kk["Cs"], kk["M"], kk["Q"], kk["Qd"],
+                                                        kk["gap"], kk["fc"]])
+    n_sc = form.n_sc
+    sc = np.array([p.get("sc", np.zeros(0)) for p in parts]).reshape(len(parts), n_sc)
+    gaps, contact_forces = np.zeros((len(parts), n_sc)), np.zeros((len(parts), n_sc))
+    acc = np.zeros_like(q)
     lam = np.zeros((len(parts), model.n_c))
     s_dot = np.zeros((len(parts), n_s))
     pos, vel, kin, pot = (np.zeros(len(parts)) for _ in range(4))
     reactions = {name.split("[")[0]: np.zeros((len(parts), 3)) for name in model.row_names}
     for i, (p, ti) in enumerate(zip(parts, t)):
         w = p.get("w", np.zeros(n_s))
-        c, cdot, sd, cq, cs, mass, force, qd = drift(p["q"], p["v"], p["s"], w, ti)
+        c, cdot, sd, cq, cs, mass, force, qd, gap, fc = drift(p["q"], p["v"], p["s"], w, ti, sc[i])
+        gaps[i], contact_forces[i] = np.asarray(gap).ravel(), np.asarray(fc).ravel()
         s_dot[i] = np.asarray(sd).ravel()
         pos[i] = np.abs(np.asarray(c)).max(initial=0.0)
         vel[i] = np.abs(np.asarray(cdot)).max(initial=0.0)
         # Multipliers from the KKT system at each output (exact for the state, whatever IDAS's
         # tolerance on algebraic variables): the same for every formulation.
         if model.n_c:
-            _, _, lam[i] = kkt_solve(to_scipy(mass), np.asarray(force).ravel(), to_scipy(cq),
-                                     np.asarray(ca.densify(cs)), np.asarray(qd).ravel())
+            a_i, _, lam[i] = kkt_solve(to_scipy(mass), np.asarray(force).ravel(), to_scipy(cq),
+                                       np.asarray(ca.densify(cs)), np.asarray(qd).ravel())
+        else:
+            a_i = spla.spsolve(to_scipy(mass).tocsc(), np.asarray(force).ravel()) if n_f else np.zeros(0)
+        acc[i, model.free] = form.to_physical(np.atleast_1d(a_i))
         e_k, e_p = energy(p["q"], p["v"])
         kin[i], pot[i] = float(e_k), float(e_p)
         _reactions(model, form, np.asarray(ca.densify(cq)), lam[i], reactions, i)
@@ -353,7 +398,9 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
         t_s=np.asarray(t), q=q, v=v, s_m=s, s_dot_m_s=s_dot, multipliers=lam, row_names=model.row_names,
         coordinate_names=model.coordinate_names(), reactions_N=reactions,
         energy_J={"kinetic": kin, "potential": pot, "total": kin + pot}, position_drift=pos, velocity_drift=vel,
-        stats=stats,
+        stats=stats, a=acc,
+        contacts={ct.joint.name: {"s_m": sc[:, k], "gap_m": gaps[:, k], "force_N": contact_forces[:, k]}
+                  for k, ct in enumerate(model.contacts)},
     )
 
 

@@ -10,6 +10,8 @@ NUMERICAL_PARAMETERS = [
     Parameter("elements_per_span", 20, "-", "contact/messenger-wire elements per span (rounded per dropper interval)",
               minimum=1, maximum=400),
     Parameter("element", "cable3d", "", "ANCF element of the wires", choices=("cable3d", "beam3d")),
+    Parameter("wires", "nonlinear", "", "wire elasticity: nonlinear (ANCF) or linearized about the static catenary",
+              choices=("nonlinear", "linear")),
     Parameter("contact", "penalty", "", "penalty (unilateral, loss of contact) or bilateral (always on the wire)",
               choices=("penalty", "bilateral")),
     Parameter("contact_stiffness", 5.0e4, "N/m", "penalty contact stiffness", minimum=0.0, exclusive_minimum=True),
@@ -28,7 +30,7 @@ NUMERICAL_PARAMETERS = [
 
 def numerical_options(p: dict) -> dict:
     """Keyword arguments of :func:`run_passage` from the shared parameters."""
-    return dict(elements_per_span=p["elements_per_span"], element=p["element"], contact=p["contact"],
+    return dict(elements_per_span=p["elements_per_span"], element=p["element"], contact=p["contact"], wires=p["wires"],
                 contact_stiffness=p["contact_stiffness"], contact_damping=p["contact_damping"],
                 analysis_spans=p["analysis_spans"], dt=p["dt"], rho_inf=p["rho_inf"], tol=p["tol"],
                 t_end=None if p["t_end"] < 0 else p["t_end"], record_every=p["snapshot_interval"],

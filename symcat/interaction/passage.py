@@ -75,14 +75,16 @@ def run_passage(design: CatenaryDesign, pantographs: list[LumpedPantograph], spe
                 contact_stiffness: float = 5.0e4, contact_damping: float = 0.0, analysis_spans: int = 2,
                 lead_in: float | None = None, dt: float = 1e-3, rho_inf: float = 0.8, tol: float = 1e-7,
                 t_end: float | None = None, record_every: float = 0.01, progress: bool = True,
-                form: FormFindingResult | None = None) -> PassageResult:
+                form: FormFindingResult | None = None, wires: str = "nonlinear") -> PassageResult:
     """Form-find ``design``, run ``pantographs`` over it at ``speed`` (m/s), return statistics.
 
     The last pantograph in the list leads; each follows the one in front at ``spacing`` (m).
     The trailing pantograph starts ``lead_in`` (default: one span) before the analysis section,
     which is the central ``analysis_spans`` spans when every pantograph fits on the line, and
     otherwise the last spans the leading pantograph can cross before the final span. ``t_end``
-    (s) overrides the duration; ``t_end=0`` computes the static state only.
+    (s) overrides the duration; ``t_end=0`` computes the static state only. ``wires="linear"``
+    linearizes the wires' elastic forces about the static catenary (droppers, supports and
+    contact stay nonlinear).
     """
     t0 = time.perf_counter()
     if not pantographs:
@@ -102,8 +104,11 @@ def run_passage(design: CatenaryDesign, pantographs: list[LumpedPantograph], spe
         raise ParameterError(f"n_spans={design.n_spans}: {len(pantographs)} pantograph(s) {spacing:g} m apart with "
                              f"{analysis_spans} analysis spans and a {lead_in:g} m lead-in need at least {need} spans")
     runs = [PantographRun(p, x_trail + k * spacing) for k, p in enumerate(pantographs)]
+    if wires not in ("nonlinear", "linear"):
+        raise ParameterError(f"wires={wires!r}: must be nonlinear or linear")
     if form is None:
         form = find_form(design, elements_per_span, element)
+    form.structure.linearize_wires(form.q if wires == "linear" else None)
     line = CoupledLine(form, runs, speed, contact, contact_stiffness, contact_damping)
     duration = (section[1] - x_trail) / speed + 1e-9 if t_end is None else float(t_end)
     if duration > 0 and max(r.x_start for r in runs) + speed * duration > design.length:

@@ -1,5 +1,6 @@
 """What the user describes: ANCF and rigid bodies, joints, force elements, supports and loads."""
 from .ancf import AncfBody
+from .contact import PenaltyContact
 from .forces import PointLoad, RotationalSpring, SpringDamper
 from .joints import GROUND, Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical
 from .loads import NodalForce, SlopeMoment
@@ -8,6 +9,6 @@ from .scene import Scene
 from .sections import Material, Section
 
 __all__ = [
-    "GROUND", "AncfBody", "Driving", "Fixed", "Material", "NodalForce", "PointLoad", "Prismatic", "Revolute",
+    "GROUND", "AncfBody", "Driving", "Fixed", "Material", "NodalForce", "PenaltyContact", "PointLoad", "Prismatic", "Revolute",
     "RigidBody", "RotationalSpring", "Scene", "Section", "SlidingJoint", "SlopeMoment", "Spherical", "SpringDamper",
 ]

@@ -8,13 +8,14 @@ import numpy as np
 
 from ..errors import ParameterError
 from .ancf import AncfBody
+from .contact import PenaltyContact
 from .forces import PointLoad, RotationalSpring, SpringDamper
 from .joints import Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical
 from .loads import NodalForce, SlopeMoment
 from .rigid import RigidBody
 
 JOINT_TYPES = (Spherical, Revolute, Prismatic, Fixed, Driving, SlidingJoint)
-FORCE_TYPES = (SpringDamper, RotationalSpring, PointLoad)
+FORCE_TYPES = (SpringDamper, RotationalSpring, PointLoad, PenaltyContact)
 
 
 @dataclass
@@ -46,8 +47,9 @@ class Scene:
                 raise ParameterError(f"name {item.name!r}: already used by a joint or force element")
             for ref in _body_refs(item):
                 self.check_body_ref(ref, item.name)
-            if isinstance(item, SlidingJoint) and not isinstance(self.find(item.wire), AncfBody):
-                raise ParameterError(f"sliding joint {item.name!r}: wire={item.wire!r} is not an ANCF body")
+            if isinstance(item, (SlidingJoint, PenaltyContact)) and not isinstance(self.find(item.wire), AncfBody):
+                kind = "sliding joint" if isinstance(item, SlidingJoint) else "contact"
+                raise ParameterError(f"{kind} {item.name!r}: wire={item.wire!r} is not an ANCF body")
             (self.joints if isinstance(item, JOINT_TYPES) else self.force_elements).append(item)
         elif isinstance(item, (NodalForce, SlopeMoment)):
             body = self.body(item.body)
@@ -98,7 +100,7 @@ class Scene:
 
 
 def _body_refs(item) -> list:
-    if isinstance(item, SlidingJoint):
+    if isinstance(item, (SlidingJoint, PenaltyContact)):
         return [item.body]
     if isinstance(item, (Driving, PointLoad)):
         return [item.body]

@@ -157,3 +157,16 @@ def test_two_pantographs_each_get_statistics():
     for s in res.statistics:
         assert 100 < s["contact_force_mean_N"] < 200
     assert math.isclose(res.record.x_contact_m[0, 1] - res.record.x_contact_m[0, 0], 110.0)
+
+
+def test_linearized_wires_agree_with_nonlinear_ancf(short_line):
+    """Around the static catenary the wires' geometric nonlinearity is small: the two models
+    must give the same statistics (and the linear one must really differ in the forces)."""
+    d = short_line.structure.design
+    runs = {w: run_passage(d, [benchmark2015_pantograph(250)], 250 / 3.6, analysis_spans=1, form=short_line,
+                           wires=w, progress=False) for w in ("linear", "nonlinear")}
+    a, b = runs["linear"].statistics[0], runs["nonlinear"].statistics[0]
+    for key in ("contact_force_mean_N", "contact_force_std_N", "contact_force_max_N"):
+        assert a[key] == pytest.approx(b[key], rel=5e-3)
+    assert not np.array_equal(runs["linear"].record.contact_force_N, runs["nonlinear"].record.contact_force_N)
+    short_line.structure.linearize_wires(None)

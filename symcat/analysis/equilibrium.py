@@ -1,0 +1,228 @@
+"""Static equilibrium of a multibody model (rigid bodies, ANCF wires, joints, sliding joints,
+penalty contacts), the state every dynamic run should start from.
+
+Unknowns ``u = [q, s, s_c, lambda]`` (free coordinates, sliding-joint and contact arc lengths,
+multipliers) solve the KKT system at ``v = 0``::
+
+    R(u) = [Q(q, s_c) - C_q^T lambda,  -C_s^T lambda,  C(q, s, t),  T(q, s_c)] = 0
+
+with the Jacobian ``J`` from CasADi (compiled kernel companions).
+
+Plain Newton stalls here: a frictionless sliding point on a straight wire has no stiffness
+along the wire until the wire sags (a singular Jacobian at the start, and a load continuation
+jumps: for any load the point belongs at the lowest place, not where it started), and the
+curvature of the C1 interpolation jumps at element ends, so residual-norm backtracking rejects
+good steps there. The solver therefore uses *pseudo-transient continuation*: each iteration is
+an implicit step of the motion from rest, ``(J - M / h^2) du = -R`` (``M`` the mass matrix on
+the coordinates, nothing on arc lengths and multipliers), whose pseudo time step ``h`` grows as
+the force residual falls (switched evolution relaxation) until it is infinite and the iteration
+is (nearly) Newton's method, with its fast convergence. The pseudo-inertia bounds every step
+while the motion is large, follows the stable (energy-decreasing) branch, and makes the matrix
+regular; a step whose residual explodes is retried with a quarter of ``h``. Arc lengths move
+at most a quarter element per iteration. ``h`` stops at ``max_pseudo_time``, where ``M / h^2``
+is a negligible stiffness that still keeps neutral directions (a body spinning freely about its
+contact point) regular.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
+
+from ..assembly.multibody import MultibodyModel
+from ..assembly.sparse import to_scipy
+from ..dae.formulation import Formulation
+from ..errors import SolverError
+from ..integrate.simulate import _reactions
+
+
+@dataclass
+class EquilibriumResult:
+    """Outcome of :func:`solve_equilibrium`.
+
+    Attributes
+    ----------
+    q : ndarray (n_q,)
+        All generalized coordinates at equilibrium (fixed ones included).
+    s_m, sc_m : ndarray
+        Arc lengths (m) of the sliding joints and of the penalty contacts.
+    multipliers : ndarray (n_c,)
+        Lagrange multipliers (``row_names`` of the model).
+    residual_N : float
+        Max-norm of the force rows ``Q - C_q^T lambda`` (N, N m).
+    constraint_residual : float
+        Max-norm of ``C`` and of the tangency conditions (m).
+    iterations : int
+    wall_s : float
+    history : list of (iteration, h, force residual, accepted)
+    reactions_N : dict
+        Joint name -> constraint force (global, N) on the joint's ``body`` (sliding, driving)
+        or ``body_j``, as in :class:`symcat.integrate.SimulationResult`.
+    contact_gap_m, contact_force_N : dict
+        Penalty contact name -> normal gap (m) and normal force (N).
+    """
+
+    q: np.ndarray
+    s_m: np.ndarray
+    sc_m: np.ndarray
+    multipliers: np.ndarray
+    residual_N: float
+    constraint_residual: float
+    iterations: int
+    wall_s: float
+    history: list = field(default_factory=list)
+    reactions_N: dict = field(default_factory=dict)
+    contact_gap_m: dict = field(default_factory=dict)
+    contact_force_N: dict = field(default_factory=dict)
+
+    def apply(self, model: MultibodyModel) -> None:
+        """Make this equilibrium the initial state of ``model`` (positions and arc lengths)."""
+        model.q0 = self.q.copy()
+        model.s0 = self.s_m.copy()
+        model.sc0 = self.sc_m.copy()
+        for sl, s in zip(model.windowed(), np.r_[self.s_m, self.sc_m]):
+            model.set_window(sl, s)
+
+    def stats(self) -> dict:
+        return {"iterations": self.iterations, "residual_N": self.residual_N,
+                "constraint_residual_m": self.constraint_residual, "wall_s": self.wall_s}
+
+
+class _Kkt:
+    """The residual ``R(u)``, its sparse Jacobian and the mass matrix as one CasADi function."""
+
+    def __init__(self, model: MultibodyModel, t: float):
+        form = Formulation(model, "augmented", "1")
+        self.form = form
+        n_f, n_s, n_sc, n_c = form.n_f, form.n_s, form.n_sc, form.n_c
+        self.sizes = (n_f, n_s, n_sc, n_c)
+        u = ca.MX.sym("u", n_f + n_s + n_sc + n_c)
+        q, s = u[:n_f], u[n_f : n_f + n_s]
+        sc, lam = u[n_f + n_s : n_f + n_s + n_sc], u[n_f + n_s + n_sc :]
+        k = form.terms(q, ca.MX.zeros(n_f), s, ca.MX.zeros(n_s), ca.MX(t), sc)
+        r = ca.vertcat(k["Q"] - ca.mtimes(k["Cq"].T, lam), -ca.mtimes(k["Cs"].T, lam), k["C"], k["T"])
+        self.fn = ca.Function("kkt", [u], [r, ca.jacobian(r, u), k["M"]])
+        self.extras = ca.Function("extras", [u], [k["Cq"], k["gap"], k["fc"]])
+        self.n_force = n_f + n_s
+
+    def __call__(self, u):
+        r, j, m = self.fn(u)
+        return np.asarray(r).ravel(), to_scipy(j).tocsc(), to_scipy(m).tocsc()
+
+
+def solve_equilibrium(model: MultibodyModel, t: float = 0.0, rtol: float = 1e-9, max_iterations: int = 200,
+                      pseudo_time_step: float = 1e-2, max_pseudo_time: float = 1e3) -> EquilibriumResult:
+    """Static equilibrium of ``model`` at time ``t`` (driving constraints evaluated at ``t``).
+
+    Parameters
+    ----------
+    model : MultibodyModel
+        Starts from its initial state (``q0``, ``s0``, ``sc0``); call
+        :meth:`EquilibriumResult.apply` to start a simulation from the result.
+    t : float
+        Time (s) of the driving constraints.
+    rtol : float
+        Convergence: force residual below ``rtol`` times the initial one (N) and constraint
+        residual below ``rtol`` times the model size (m).
+    max_iterations : int
+        Iterations allowed.
+    pseudo_time_step : float
+        Initial pseudo time step ``h`` (s): the first step moves a free body about ``g h^2``.
+    max_pseudo_time : float
+        Largest ``h`` (s): ``M / h^2`` is then a negligible stiffness that keeps neutral
+        directions (a body spinning freely about its contact point) regular.
+
+    Raises
+    ------
+    SolverError
+        Naming the largest residual row.
+    """
+    t0 = time.perf_counter()
+    saved = [sl.window for sl in model.windowed()]
+    for sl in model.windowed():
+        sl.window = (0, len(sl.element_start) - 1)  # the whole wire: no window moves inside Newton
+    try:
+        kkt = _Kkt(model, t)
+        return _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, pseudo_time_step, t0)
+    finally:
+        for sl, w in zip(model.windowed(), saved):
+            sl.window = w
+
+
+def _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, h0, t0):
+    form = kkt.form
+    n_f, n_s, n_sc, n_c = kkt.sizes
+    u = np.r_[form.to_internal(model.q0[model.free]), model.s0, model.sc0, np.zeros(n_c)]
+    r, j, mass = kkt(u)
+    nf = kkt.n_force
+    force_tol = rtol * max(np.abs(r[:nf]).max(initial=0.0), 1.0)
+    geo_tol = rtol * (1.0 + np.abs(model.q0).max(initial=0.0))
+    # Round-off floor of the force residual: stiff wires (EA ~ 1e9 N) cannot get below ~1e-15 EA/L.
+    force_tol = max(force_tol, 1e-15 * np.abs(j.diagonal()[:n_f]).max(initial=0.0) * (1.0 + np.abs(model.q0).max(initial=0.0)))
+    pad = sps.csc_matrix((len(u) - n_f, len(u) - n_f))
+    limits = _arc_limits(model)
+    h, history = h0, []
+    f_norm = np.abs(r[:nf]).max(initial=0.0)
+    for it in range(1, max_iterations + 1):
+        g_norm = np.abs(r[nf:]).max(initial=0.0)
+        if f_norm <= force_tol and g_norm <= geo_tol:
+            break
+        inertia = sps.block_diag([mass / h**2, pad])
+        with np.errstate(all="ignore"):
+            du = spla.spsolve((j - inertia).tocsc(), -r)
+        if not np.all(np.isfinite(du)):
+            h /= 4
+            continue
+        arc = du[n_f : n_f + n_s + n_sc]
+        if arc.size and np.any(np.abs(arc) > limits):
+            du *= np.min(limits / np.maximum(np.abs(arc), 1e-300))
+        r_new, j_new, mass_new = kkt(u + du)
+        f_new = np.abs(r_new[:nf]).max(initial=0.0)
+        if not np.isfinite(f_new) or f_new > 1e3 * max(f_norm, force_tol):
+            h /= 4  # rejected: more pseudo-inertia
+            history.append((it, h, f_norm, False))
+            continue
+        u, r, j, mass = u + du, r_new, j_new, mass_new
+        # The pseudo time step doubles while the force residual falls, up to max_pseudo_time,
+        # where the iteration is Newton's method with a negligible M / h^2 that keeps neutral
+        # directions (a free spin) regular.
+        if f_new < f_norm:
+            h = min(2 * h, max_pseudo_time)
+        f_norm = f_new
+        history.append((it, h, f_norm, True))
+    else:
+        raise SolverError(_failure_message(model, kkt, u, max_iterations))
+    q = model.q0.copy()
+    q[model.free] = form.to_physical(u[:n_f])
+    lam = u[n_f + n_s + n_sc :].copy()
+    cq, gap, fc = (np.asarray(ca.densify(x)) for x in kkt.extras(u))
+    reactions = {name.split("[")[0]: np.zeros((1, 3)) for name in model.row_names}
+    _reactions(model, form, cq, lam, reactions, 0)
+    names = [ct.joint.name for ct in model.contacts]
+    return EquilibriumResult(
+        q=q, s_m=u[n_f : n_f + n_s].copy(), sc_m=u[n_f + n_s : n_f + n_s + n_sc].copy(),
+        multipliers=lam, residual_N=float(f_norm),
+        constraint_residual=float(np.abs(r[nf:]).max(initial=0.0)), iterations=len(history),
+        wall_s=time.perf_counter() - t0, history=history, reactions_N={k: v[0] for k, v in reactions.items()},
+        contact_gap_m=dict(zip(names, gap.ravel().tolist())), contact_force_N=dict(zip(names, fc.ravel().tolist())))
+
+
+def _arc_limits(model) -> np.ndarray:
+    """Largest arc-length change per iteration: a quarter of the shortest element."""
+    return np.array([0.25 * np.diff(sl.element_start).min() for sl in model.windowed()])
+
+
+def _failure_message(model, kkt, u, iterations) -> str:
+    r = np.abs(kkt(u)[0])
+    n_f, n_s, n_sc, n_c = kkt.sizes
+    coords = [model.coordinate_names()[i] for i in model.free]
+    names = ([f"force on {c}" for c in coords] + [f"C_s^T lambda of {sl.joint.name}" for sl in model.sliding]
+             + [f"constraint {n}" for n in model.row_names] + [f"tangency of contact {ct.joint.name}" for ct in model.contacts])
+    worst = int(np.argmax(r))
+    return (f"static equilibrium not found in {iterations} iterations; largest residual: {names[worst]} "
+            f"({r[worst]:.3g}). Check for a mechanism without stiffness, a body that loses its support, or a contact "
+            "point that leaves its wire")
