@@ -73,7 +73,7 @@ def spans_needed(span_length: float, n_pantographs: int, spacing: float, analysi
 def run_passage(design: CatenaryDesign, pantographs: list[LumpedPantograph], speed: float, spacing: float = 200.0,
                 elements_per_span: int = 20, element: str = "cable3d", contact: str = "penalty",
                 contact_stiffness: float = 5.0e4, contact_damping: float = 0.0, analysis_spans: int = 2,
-                lead_in: float | None = None, dt: float = 1e-3, rho_inf: float = 0.8, tol: float = 1e-7,
+                lead_in: float | None = None, dt: float = 1e-3, rho_inf: float = 0.8, tol: float = 1e-5,
                 t_end: float | None = None, record_every: float = 0.01, progress: bool = True,
                 form: FormFindingResult | None = None, wires: str = "nonlinear") -> PassageResult:
     """Form-find ``design``, run ``pantographs`` over it at ``speed`` (m/s), return statistics.
