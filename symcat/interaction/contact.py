@@ -62,14 +62,19 @@ class WireLocator:
         self.z_index = np.asarray(z_index)
         self.zx_index = np.asarray(zx_index)
         self.lengths = np.asarray(lengths, dtype=float)
+        self._last = -1  # element of the previous call (pan-heads move little per call)
 
     def locate(self, q: np.ndarray, x: float) -> WirePoint:
         """The wire point at ``x``: element by the current nodal x, then two Newton steps on xi."""
-        xs = q[self.x_index]
-        k = int(np.clip(np.searchsorted(xs, x, side="right") - 1, 0, len(xs) - 2))
+        k = self._last
+        ix = self.x_index
+        if not (0 <= k < len(ix) - 1 and q[ix[k]] <= x < q[ix[k + 1]]):  # moved on: search again
+            k = int(np.clip(np.searchsorted(q[ix], x, side="right") - 1, 0, len(ix) - 2))
+            self._last = k
+        x0, x1 = q[ix[k]], q[ix[k + 1]]
         length = self.lengths[k]
-        cx = np.array([xs[k], length * q[self.xx_index[k]], xs[k + 1], length * q[self.xx_index[k + 1]]])
-        xi = (x - xs[k]) / (xs[k + 1] - xs[k])
+        cx = np.array([x0, length * q[self.xx_index[k]], x1, length * q[self.xx_index[k + 1]]])
+        xi = (x - x0) / (x1 - x0)
         for _ in range(3):
             n, dn = hermite(xi)
             xi -= (n @ cx - x) / (dn @ cx)

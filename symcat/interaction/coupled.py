@@ -17,7 +17,7 @@ import scipy.sparse.linalg as spla
 from ..catenary.formfinding import FormFindingResult
 from ..errors import ParameterError, SolverError
 from ..pantograph.lumped import LumpedPantograph
-from .contact import WireLocator, WirePoint
+from .contact import WireLocator, WirePoint, hermite
 
 CONTACT_MODELS = ("penalty", "bilateral")
 
@@ -144,8 +144,6 @@ class CoupledLine:
 
     def _slope(self, q: np.ndarray, point: WirePoint) -> float:
         """dz/dx of the contact wire at the contact point."""
-        from .contact import hermite
-
         k, length = point.element, self.locator.lengths[point.element]
         _, dn = hermite(point.xi)
         lz = np.array([1.0, length, 1.0, length])

@@ -64,6 +64,27 @@ class _Stepper:
         s = (line.M + self.gamma_p * line.C + self.beta_p * k).tocsr()
         self.lu = BandedCholesky(s, getattr(line, "_band_permutation", None))
         line._band_permutation = self.lu.permutation  # same pattern for every step size
+        self._columns: dict[int, np.ndarray] = {}
+
+    def column(self, i: int) -> np.ndarray:
+        """``S^-1 e_i``, cached: a contact's ``S^-1 g`` is a weighted sum of a few of these, and
+        the contact stays on the same element for many steps."""
+        col = self._columns.get(i)
+        if col is None:
+            if len(self._columns) > 64:
+                self._columns.clear()
+            e = np.zeros(self.lu.n)
+            e[i] = 1.0
+            col = self._columns[i] = self.lu.solve(e)
+        return col
+
+    def influence(self, states) -> np.ndarray:
+        """``S^-1 g`` of every contact (n x n_contacts)."""
+        z = np.zeros((self.lu.n, len(states)))
+        for p, s in enumerate(states):
+            for i, w in zip(s.g_index, s.g):
+                z[:, p] += w * self.column(int(i))
+        return z
 
 
 def integrate(line: CoupledLine, t_end: float, dt: float = 1e-3, rho_inf: float = 0.8, tol: float = 1e-8,
@@ -189,10 +210,7 @@ def _step(line: CoupledLine, st: _Stepper, coef: AlphaParameters, t, y, v, acc, 
         f, states, fc = line.forces(y1, v1, t1, states, lam1 if bilateral else None)
         r = line.M @ acc1 - f
         if z is None:  # S^-1 g of every contact (the point moves little within a step)
-            g_mat = np.zeros((line.n, n_c))
-            for p, s in enumerate(states):
-                g_mat[s.g_index, p] = s.g
-            z = st.lu.solve(g_mat)
+            z = st.influence(states)
         g_rows = [s.g_index for s in states]
         x = st.lu.solve(-r)
         if bilateral:
