@@ -39,6 +39,7 @@ class ContactState:
     delta_rate: float  # m/s
     g: np.ndarray  # d delta / d y on the entries ``g_index``
     g_index: np.ndarray
+    slope: float = 0.0  # dz/dx of the wire at the contact point
 
 
 class CoupledLine:
@@ -139,7 +140,7 @@ class CoupledLine:
             rate = y_dot[head] - point.weights @ v_full - slope * self.speed
             g_index = np.concatenate([[head], pos[keep]])
             g = np.concatenate([[1.0], -point.weights[keep]])
-            states.append(ContactState(point, float(delta), float(rate), g, g_index))
+            states.append(ContactState(point, float(delta), float(rate), g, g_index, slope))
         return states
 
     def _slope(self, q: np.ndarray, point: WirePoint) -> float:
@@ -178,6 +179,44 @@ class CoupledLine:
         for s, fc in zip(states, contact_forces):
             np.add.at(out, s.g_index, -fc * s.g)
         return out, states, np.asarray(contact_forces, dtype=float)
+
+    # --- energy ---------------------------------------------------------------------------
+    def energy(self, y: np.ndarray, y_dot: np.ndarray, t: float) -> dict[str, float]:
+        """Kinetic and potential energy (J) of catenary, pantographs and penalty contact.
+
+        The potential's gradient is minus the conservative forces: wire strain energy, gravity
+        and end tensions (constant loads), tension-only droppers, preloaded support springs,
+        pantograph springs and static forces, the penalty spring. Its explicit time dependence
+        (the contact point moves) is the work done on the system, ``-f_c slope v`` per contact.
+        """
+        st = self.structure
+        q = self.catenary_q(y)
+        strain = st.system.strain_energy(q) if st._linear is None else float(
+            -st._linear(q) @ (q - self.q_static) * 0.5 - st._linear(self.q_static) @ (q - self.q_static) * 0.5)
+        ext = -float(st._f_ext @ (q - self.q_static))
+        _, length, _ = st.dropper_state(q)
+        stretch = np.maximum(length - st.dropper_length, 0.0)
+        droppers = float(0.5 * np.sum(st.dropper_stiffness() * stretch**2))
+        supports = 0.0
+        for sup, xyz in ((st.cw_supports, st.cw_xyz), (st.mw_supports, st.mw_xyz)):
+            z = q[xyz[sup.nodes, 2]]
+            supports += float(np.sum(0.5 * sup.stiffness * (z - sup.height) ** 2 - sup.preload * z))
+        panto = 0.0
+        for p, sl in enumerate(self.panto_slices):
+            u = y[sl]
+            panto += float(0.5 * u @ self.K_panto[p] @ u - self.f_panto[p] @ u)
+        contact = 0.0
+        if self.contact == "penalty":
+            for s in self.contact_states(y, y_dot, t):
+                contact += 0.5 * self.k_c * max(s.delta, 0.0) ** 2
+        kinetic = float(0.5 * y_dot @ (self.M @ y_dot))
+        potential = strain + ext + droppers + supports + panto + contact
+        return {"kinetic_J": kinetic, "potential_J": potential, "total_J": kinetic + potential}
+
+    def dissipation_power(self, y_dot: np.ndarray) -> float:
+        """Power dissipated by Rayleigh and pantograph dampers (W); dropper and contact
+        dampers are not included."""
+        return float(y_dot @ (self.C @ y_dot))
 
     # --- static equilibrium ---------------------------------------------------------------
     def _place_pantographs(self, y: np.ndarray, load: np.ndarray) -> None:

@@ -29,8 +29,8 @@ class PassageRecorder:
         self.record_every = record_every
         self._rows: dict[str, list] = {k: [] for k in (
             "t_s", "x_contact_m", "contact_force_N", "penetration_m", "panhead_z_m", "panhead_acc_m_s2",
-            "support_z_m", "dropper_tension_N", "iterations")}
-        self._snap_t, self._snap_q, self._snap_u = [], [], []
+            "support_z_m", "dropper_tension_N", "iterations", "work_power_W", "dissipation_power_W")}
+        self._snap_t, self._snap_q, self._snap_u, self._snap_e = [], [], [], []
         self._next_snapshot = 0.0
         self.stats: dict = {}
 
@@ -48,10 +48,14 @@ class PassageRecorder:
         rows["support_z_m"].append(q[st.cw_xyz[st.support_nodes, 2]])
         rows["dropper_tension_N"].append(st.dropper_state(q)[2])
         rows["iterations"].append(iterations)
+        # work done by the moving contact points (explicit time dependence of the contact)
+        rows["work_power_W"].append(sum(-f * s.slope * line.speed for f, s in zip(contact_forces, states)))
+        rows["dissipation_power_W"].append(line.dissipation_power(v))
         if t >= self._next_snapshot - 1e-12:
             self._snap_t.append(t)
             self._snap_q.append(q)
             self._snap_u.append(y[line.n_cat:].copy())
+            self._snap_e.append(line.energy(y, v, t)["total_J"])
             self._next_snapshot += self.record_every
 
     def finish(self, **stats) -> None:
@@ -70,6 +74,20 @@ class PassageRecorder:
         if name == "snapshot_pantograph_m":
             return np.asarray(self._snap_u)
         raise AttributeError(name)
+
+    def energy_balance(self) -> dict[str, np.ndarray]:
+        """Energy (J) at the snapshots against the work done by the moving contacts minus the
+        damper dissipation since the start (trapezoidal rule over the steps). ``error_J`` is
+        what the time integration lost or gained (generalized-alpha with rho_inf < 1 damps)."""
+        t = np.asarray(self._rows["t_s"])
+        net = np.asarray(self._rows["work_power_W"]) - np.asarray(self._rows["dissipation_power_W"])
+        cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (net[1:] + net[:-1]) * np.diff(t))])
+        ts = self.snapshot_t_s
+        energy = np.asarray(self._snap_e)
+        expected = energy[0] + np.interp(ts, t, cumulative)
+        work = np.concatenate([[0.0], np.cumsum(0.5 * np.abs(np.asarray(self._rows["work_power_W"]))[1:] * np.diff(t))])
+        return {"t_s": ts, "energy_J": energy, "expected_J": expected, "error_J": energy - expected,
+                "work_scale_J": float(work[-1])}
 
     @property
     def static_support_z_m(self) -> np.ndarray:

@@ -170,3 +170,18 @@ def test_linearized_wires_agree_with_nonlinear_ancf(short_line):
         assert a[key] == pytest.approx(b[key], rel=5e-3)
     assert not np.array_equal(runs["linear"].record.contact_force_N, runs["nonlinear"].record.contact_force_N)
     short_line.structure.linearize_wires(None)
+
+
+@pytest.mark.parametrize("rayleigh", [0.0, 1.0])
+def test_energy_balance_closes(rayleigh):
+    """Energy change = work of the moving contact - damper dissipation (undamped and damped)."""
+    d = benchmark2015(n_spans=5)
+    d = d.with_(rayleigh_alpha=rayleigh * d.rayleigh_alpha, rayleigh_beta=rayleigh * d.rayleigh_beta)
+    form = find_form(d, 20)
+    res = run_passage(d, [benchmark2015_pantograph(250)], 250 / 3.6, form=form, progress=False, dt=5e-4,
+                      rho_inf=1.0, analysis_spans=1)
+    balance = res.record.energy_balance()
+    assert balance["work_scale_J"] > 5.0
+    assert np.abs(balance["error_J"]).max() < 0.01 * balance["work_scale_J"]
+    if rayleigh:
+        assert np.sum(res.record.dissipation_power_W) > 0
