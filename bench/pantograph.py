@@ -48,6 +48,46 @@ def _row(label, stats, ratio, ref):
     return f"| {label} | " + " | ".join(cells) + f" | {ratio:.2f} |"
 
 
+def hard_cases() -> list[str]:
+    """The issue's hard cases run through a whole passage: near the wave speed, two
+    pantographs, more than 1 km of line."""
+    rows = []
+    cases = [
+        ("0.9 x wave speed (413.6 km/h), uplift 169 N", dict(speed_kmh=413.6, n_spans=10, pantographs=1)),
+        ("two pantographs 200 m apart, 320 km/h", dict(speed_kmh=320.0, n_spans=13, pantographs=2)),
+        ("1.16 km passage (24 spans, 20 analysed), 320 km/h", dict(speed_kmh=320.0, n_spans=24, pantographs=1,
+                                                                  analysis_spans=20)),
+    ]
+    for label, c in cases:
+        design = benchmark2015(c["n_spans"])
+        panto = benchmark2015_pantograph(320)
+        t0 = time.perf_counter()
+        res = run_passage(design, [panto] * c["pantographs"], c["speed_kmh"] / 3.6, elements_per_span=40, dt=5e-4,
+                          analysis_spans=c.get("analysis_spans", 2), progress=False)
+        wall = time.perf_counter() - t0
+        rec = res.record
+        balance = rec.energy_balance()
+        slack = int(np.sum(np.diff((rec.dropper_tension_N <= 0).astype(int), axis=0) == 1))
+        for p, stats in enumerate(res.statistics):
+            rows.append(f"| {label} | {p + 1} | {stats['contact_force_mean_N']:.1f} | {stats['contact_force_std_N']:.1f} | "
+                        f"{stats['contact_force_min_N']:.1f} | {stats['contact_loss_percent']:.2f} | "
+                        f"{1e3 * stats['support_uplift_max_m']:.1f} | {slack} | "
+                        f"{np.abs(balance['error_J']).max():.3f} / {balance['work_scale_J']:.1f} | "
+                        f"{rec.stats['halvings']} | {wall / res.simulated_s:.2f} |")
+    return [
+        "### Hard cases (40 elements/span, dt 0.5 ms, penalty contact)",
+        "",
+        "| case | pantograph | mean [N] | std [N] | min [N] | loss [%] | uplift [mm] | slack-dropper events | "
+        "energy error / contact work [J] | step halvings | wall / simulated |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        *rows,
+        "",
+        "The energy error includes the numerical dissipation of generalized-alpha (rho_inf 0.8); with "
+        "rho_inf = 1 the balance closes to 0.2 % of the contact work (tests/interaction).",
+        "",
+    ]
+
+
 def section(report_dir: Path) -> list[str]:
     header = ["| run | mean [N] | std [N] | max [N] | min [N] | uplift | loss [%] | wall / simulated |",
               "|---|---:|---:|---:|---:|---:|---:|---:|"]
@@ -58,6 +98,7 @@ def section(report_dir: Path) -> list[str]:
     tols = [(tol, *_run(tol=tol)) for tol in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8)]
     models = [(w, *_run(wires=w, repeats=3)) for w in ("nonlinear", "linear")]
     spans = [(n, *_run(n_spans=n, t_end=0.5, repeats=3)) for n in (10, 20, 40)]
+    hard = hard_cases()
     lines = [
         "## Pantograph/catenary: benchmark2015 at 320 km/h (one pantograph, penalty contact)",
         "",
@@ -97,6 +138,7 @@ def section(report_dir: Path) -> list[str]:
         "|---:|---:|---:|",
         *[f"| {n} | {res.line.n} | {r:.2f} |" for n, s, r, res in spans],
         "",
+        *hard,
     ]
     return lines
 

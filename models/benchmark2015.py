@@ -26,6 +26,8 @@ PARAMETERS = [
     Parameter("spacing_m", 200.0, "m", "distance between the two pantographs", minimum=0.0, exclusive_minimum=True),
     Parameter("n_spans", 0, "-", "spans of the line; 0: 10 for one pantograph, enough for two", minimum=0, maximum=200),
     Parameter("uplift_N", -1.0, "N", "static uplift; -1: EN 50367 target 0.00097 v^2 + 70 N", minimum=-1.0),
+    Parameter("aero_coefficient_N_s2_m2", 0.0, "N s^2/m^2", "aerodynamic uplift on the pan-head, c v^2 (v in m/s)",
+              minimum=0.0),
     Parameter("pantograph_damping_N_s_m", "0,0,0", "N s/m", "dampers of the three stages from the roof up, "
               "comma-separated (the public set gives none)"),
     Parameter("presag_scale", 1.0, "-", "factor on the benchmark presag target (55 mm at mid-span)", minimum=0.0),
@@ -77,8 +79,8 @@ def run(p: dict):
     base = benchmark2015_pantograph(p["speed_kmh"])
     damping = _floats("pantograph_damping_N_s_m", p["pantograph_damping_N_s_m"], 3)
     uplift = base.uplift if p["uplift_N"] < 0 else p["uplift_N"]
-    panto = LumpedPantograph(base.masses, base.stiffness, damping, uplift, base.uplift_stage, name=base.name,
-                             sources=base.sources)
+    panto = LumpedPantograph(base.masses, base.stiffness, damping, uplift, base.uplift_stage,
+                             aero_coefficient=p["aero_coefficient_N_s2_m2"], name=base.name, sources=base.sources)
     result = run_passage(design, [panto] * p["n_pantographs"], speed, spacing=p["spacing_m"], **numerical_options(p))
     extra = {"speed_kmh": p["speed_kmh"], "uplift_N": uplift, "n_spans": design.n_spans,
              "wave_speed_kmh": design.wave_speed * 3.6}
