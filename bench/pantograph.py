@@ -69,7 +69,7 @@ def hard_cases() -> list[str]:
         balance = rec.energy_balance()
         slack = int(np.sum(np.diff((rec.dropper_tension_N <= 0).astype(int), axis=0) == 1))
         for p, stats in enumerate(res.statistics):
-            rows.append(f"| {label} | {p + 1} | {stats['contact_force_mean_N']:.1f} | {stats['contact_force_std_N']:.1f} | "
+            rows.append(f"| {label} | {('leading', 'trailing')[p] if len(res.statistics) > 1 else 1} | {stats['contact_force_mean_N']:.1f} | {stats['contact_force_std_N']:.1f} | "
                         f"{stats['contact_force_min_N']:.1f} | {stats['contact_loss_percent']:.2f} | "
                         f"{1e3 * stats['support_uplift_max_m']:.1f} | {slack} | "
                         f"{np.abs(balance['error_J']).max():.3f} / {balance['work_scale_J']:.1f} | "

@@ -78,7 +78,8 @@ def run_passage(design: CatenaryDesign, pantographs: list[LumpedPantograph], spe
                 form: FormFindingResult | None = None, wires: str = "nonlinear") -> PassageResult:
     """Form-find ``design``, run ``pantographs`` over it at ``speed`` (m/s), return statistics.
 
-    The last pantograph in the list leads; each follows the one in front at ``spacing`` (m).
+    The first pantograph in the list leads; each follows the one in front at ``spacing`` (m), so
+    ``statistics[0]`` (``pantograph_1`` in model summaries) is the leading one.
     The trailing pantograph starts ``lead_in`` (default: one span) before the analysis section,
     which is the central ``analysis_spans`` spans when every pantograph fits on the line, and
     otherwise the last spans the leading pantograph can cross before the final span. ``t_end``
@@ -103,7 +104,8 @@ def run_passage(design: CatenaryDesign, pantographs: list[LumpedPantograph], spe
         need = spans_needed(L, len(pantographs), spacing, analysis_spans, lead_in)
         raise ParameterError(f"n_spans={design.n_spans}: {len(pantographs)} pantograph(s) {spacing:g} m apart with "
                              f"{analysis_spans} analysis spans and a {lead_in:g} m lead-in need at least {need} spans")
-    runs = [PantographRun(p, x_trail + k * spacing) for k, p in enumerate(pantographs)]
+    x_lead = x_trail + gap
+    runs = [PantographRun(p, x_lead - k * spacing) for k, p in enumerate(pantographs)]
     if wires not in ("nonlinear", "linear"):
         raise ParameterError(f"wires={wires!r}: must be nonlinear or linear")
     if form is None:
