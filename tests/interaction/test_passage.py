@@ -185,3 +185,14 @@ def test_energy_balance_closes(rayleigh):
     assert np.abs(balance["error_J"]).max() < 0.01 * balance["work_scale_J"]
     if rayleigh:
         assert np.sum(res.record.dissipation_power_W) > 0
+
+
+def test_solver_failure_reports_time_and_keeps_the_record(short_line):
+    from symcat.errors import SolverError
+
+    panto = benchmark2015_pantograph(250)
+    line = CoupledLine(short_line, [PantographRun(panto, 100.0)], 250 / 3.6)
+    with pytest.raises(SolverError, match=r"t=\d") as info:
+        integrate(line, 0.05, dt=1e-3, tol=1e-14, max_iterations=1, progress=False)
+    partial = info.value.partial
+    assert partial is not None and len(partial.t_s) >= 1  # the static start at least
