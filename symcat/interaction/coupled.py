@@ -14,7 +14,7 @@ import numpy as np
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
-from ..catenary.formfinding import FormFindingResult
+from ..catenary.formfinding import FormFindingResult, coupled_equilibrium
 from ..errors import ParameterError, SolverError
 from ..pantograph.lumped import LumpedPantograph
 from .contact import WireLocator, WirePoint, hermite
@@ -223,15 +223,14 @@ class CoupledLine:
         """Solve the catenary under the static contact forces ``load`` (N) and set each
         pantograph's reference height so that it stands there with exactly that force: the
         static uplift is the static contact force, as the standards define it."""
-        zero = np.zeros(self.n)
-        for _ in range(30):
-            states = self.contact_states(y, zero, 0.0)
-            f, states, _ = self.forces(y, zero, 0.0, states, load)
-            f_cat = f[: self.n_cat]
-            if np.abs(f_cat).max() < 1e-9 * max(1.0, float(np.abs(self.structure._f_ext).max())):
-                break
-            k_cat = self.structure.stiffness(self.catenary_q(y))[self.free][:, self.free]
-            y[: self.n_cat] += spla.spsolve(k_cat.tocsc(), f_cat)
+        def point_loads(q):  # the contact forces on the wire, at the pan-heads' positions
+            f = np.zeros(self.structure.n)
+            for x, fc in zip(self.x_contact(0.0), load):
+                point = self.locator.locate(q, x)
+                np.add.at(f, point.index, fc * point.weights)
+            return f, None
+
+        y[: self.n_cat] = coupled_equilibrium(self.structure, self.catenary_q(y), point_loads)[self.free]
         q = self.catenary_q(y)
         for p, (run, sl) in enumerate(zip(self.runs, self.panto_slices)):
             m, c, k = run.pantograph.matrices()

@@ -16,6 +16,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from ..errors import ParameterError, SolverError
@@ -174,8 +175,6 @@ def _integrate(line, t_end, dt, rho_inf, tol, max_iterations, record_every, prog
 
 
 def _current_stiffness(line: CoupledLine, y: np.ndarray):
-    import scipy.sparse as sps
-
     k_cat = line.structure.stiffness(line.catenary_q(y))[line.free][:, line.free]
     return sps.block_diag([k_cat] + line.K_panto, format="csc")
 
