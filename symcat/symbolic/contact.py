@@ -24,8 +24,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..catalog import ELEMENT_TYPES
-from .joints import _Side, wire_point
+from .joints import wire_frame
 
 
 @dataclass
@@ -55,23 +54,9 @@ def wire_contact(element: str, kind_j: str = "rigid") -> ContactDefinition:
     Parameters are ``[L, (d_ref_0:3 for cables), uj_0:3]``, as for the sliding joint, so the
     same frame conventions hold (``k_t`` is up for a wire along x with ``d_ref`` = y).
     """
-    etype = ELEMENT_TYPES[element]
-    e = sp.Matrix(sp.symbols(f"e_0:{etype.n_coordinates}", real=True))
-    s = sp.Symbol("s", real=True)
-    length = sp.Symbol("L", real=True)
-    r_i, r_s, r_y = wire_point(element, s / length, e, length)
-    side_j = _Side(kind_j, "j")
-    r_j = side_j.point()
-    params = [length]
-    if r_y is None:
-        d_ref = sp.Matrix(sp.symbols("d_ref_0:3", real=True))
-        params += list(d_ref)
-        r_y = d_ref
-    i_t = r_s / sp.sqrt(r_s.dot(r_s))
-    k_raw = i_t.cross(r_y)
-    k_t = k_raw / sp.sqrt(k_raw.dot(k_raw))
-    d = r_i - r_j
-    params += side_j.params
+    f = wire_frame(element, kind_j)
+    e, s, side_j, params, d, k_t = f.e, f.s, f.side_j, f.params, f.d, f.k_t
+    i_t = f.i_t
     return ContactDefinition(
         name=f"contact_{element}_{kind_j}", e=e, x_j=side_j.x, s=s, p=sp.Matrix(params),
         param_names=[str(x) for x in params], tangency=i_t.dot(d), gap=k_t.dot(d), d=d, normal=k_t,

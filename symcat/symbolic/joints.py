@@ -168,6 +168,43 @@ def wire_point(element: str, xi_of_s: sp.Expr, e: sp.Matrix, length: sp.Symbol):
     return r.subs(xi, xi_of_s), (r.diff(xi) / length).subs(xi, xi_of_s), None
 
 
+@dataclass
+class WireFrame:
+    """A body point against an ANCF element's centre line at arc length ``s``: the tangent
+    frame ``i_t, j_t, k_t`` (seed eq. 9) and ``d = r^i(s) - r_P^j``; shared by the sliding
+    joint and the unilateral contact so both use one frame convention."""
+
+    e: sp.Matrix
+    s: sp.Symbol
+    side_j: "_Side"
+    params: list
+    i_t: sp.Matrix
+    j_t: sp.Matrix
+    k_t: sp.Matrix
+    d: sp.Matrix
+
+
+def wire_frame(element: str, kind_j: str = "rigid") -> WireFrame:
+    """Tangent frame and relative position of a body point and an ANCF element (see
+    :func:`sliding`); parameters ``[L, (d_ref_0:3 for cables), body j's parameters]``."""
+    etype = ELEMENT_TYPES[element]
+    e = sp.Matrix(sp.symbols(f"e_0:{etype.n_coordinates}", real=True))
+    s = sp.Symbol("s", real=True)
+    length = sp.Symbol("L", real=True)
+    r_i, r_s, r_y = wire_point(element, s / length, e, length)
+    side_j = _Side(kind_j, "j")
+    params = [length]
+    if r_y is None:
+        d_ref = sp.Matrix(sp.symbols("d_ref_0:3", real=True))
+        params += list(d_ref)
+        r_y = d_ref
+    i_t = r_s / sp.sqrt(r_s.dot(r_s))
+    k_raw = i_t.cross(r_y)
+    k_t = k_raw / sp.sqrt(k_raw.dot(k_raw))
+    d = r_i - side_j.point()  # point() declares body j's parameters
+    return WireFrame(e, s, side_j, params + list(side_j.params), i_t, k_t.cross(i_t), k_t, d)
+
+
 def sliding(element: str, kind_j: str = "rigid") -> ConstraintDefinition:
     """Sliding joint of seed eqs. (5)-(9): a point of body j on the centre line of ANCF element i.
 
@@ -179,25 +216,9 @@ def sliding(element: str, kind_j: str = "rigid") -> ConstraintDefinition:
     element, ``xi = s / L`` (the element is straight in its reference configuration, so s equals
     the undeformed arc length, as in the paper).
     """
-    etype = ELEMENT_TYPES[element]
-    e = sp.Matrix(sp.symbols(f"e_0:{etype.n_coordinates}", real=True))
-    s = sp.Symbol("s", real=True)
-    length = sp.Symbol("L", real=True)
-    r_i, r_s, r_y = wire_point(element, s / length, e, length)
-    side_j = _Side(kind_j, "j")
-    r_j = side_j.point()
-    params = [length]
-    if r_y is None:
-        d_ref = sp.Matrix(sp.symbols("d_ref_0:3", real=True))
-        params += list(d_ref)
-        r_y = d_ref
-    i_t = r_s / sp.sqrt(r_s.dot(r_s))
-    k_raw = i_t.cross(r_y)
-    k_t = k_raw / sp.sqrt(k_raw.dot(k_raw))
-    j_t = k_t.cross(i_t)
-    d = r_i - r_j
-    c = sp.Matrix([i_t.dot(d), j_t.dot(d), k_t.dot(d)])
-    params += side_j.params
+    f = wire_frame(element, kind_j)
+    c = sp.Matrix([f.i_t.dot(f.d), f.j_t.dot(f.d), f.k_t.dot(f.d)])
+    e, s, side_j, params = f.e, f.s, f.side_j, f.params
     return ConstraintDefinition(
         name=f"sliding_{element}_{kind_j}", x_i=e, x_j=side_j.x, s=sp.Matrix([s]), t=sp.Symbol("t", real=True),
         p=sp.Matrix(params), param_names=[str(x) for x in params], c=c,
