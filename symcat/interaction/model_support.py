@@ -7,8 +7,8 @@ from ..model import ModelOutput, Parameter
 from .passage import PassageResult
 
 NUMERICAL_PARAMETERS = [
-    Parameter("elements_per_span", 40, "-", "contact/messenger-wire elements per span (rounded per dropper interval); "
-              "40 gives the statistics to about 1 % (make bench)",
+    Parameter("elements_per_span", 60, "-", "contact/messenger-wire elements per span (rounded per dropper interval); "
+              "60 gives the statistics to about 1 % (make bench)",
               minimum=1, maximum=400),
     Parameter("element", "cable3d", "", "ANCF element of the wires", choices=("cable3d", "beam3d")),
     Parameter("wires", "nonlinear", "", "wire elasticity: nonlinear (ANCF) or linearized about the static catenary",
@@ -20,9 +20,9 @@ NUMERICAL_PARAMETERS = [
     Parameter("analysis_spans", 2, "-", "spans in the analysis section (central ones)", minimum=1, maximum=100),
     Parameter("t_end", -1.0, "s", "simulated time; -1: until the last pantograph leaves the analysis section; "
               "0: static equilibrium only", minimum=-1.0),
-    Parameter("dt", 5.0e-4, "s", "time step (0.5 ms: statistics to about 0.5 %)", minimum=1e-6, maximum=0.01),
+    Parameter("dt", 1.0e-3, "s", "time step (1 ms: statistics to about 0.1 %; make bench)", minimum=1e-6, maximum=0.01),
     Parameter("rho_inf", 0.8, "-", "generalized-alpha spectral radius at infinite frequency", minimum=0.0, maximum=1.0),
-    Parameter("tol", 1.0e-5, "m", "Newton tolerance on the coordinates (1e-5 m gives the statistics to 4 digits)",
+    Parameter("tol", 1.0e-4, "m", "Newton tolerance on the coordinates (1e-4 m gives the statistics to 4 digits)",
               minimum=1e-13, maximum=1e-3),
     Parameter("snapshot_interval", 0.05, "s", "interval of wire snapshots for ParaView", minimum=1e-4),
     Parameter("paraview", True, "", "write the ParaView time series (VTU + .pvd)"),

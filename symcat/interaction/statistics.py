@@ -39,7 +39,8 @@ def lowpass(t: np.ndarray, signal: np.ndarray, cutoff_hz: float = 20.0, order: i
     if not 0 < cutoff_hz < 0.5 * fs:
         raise ParameterError(f"cutoff_hz={cutoff_hz:g}: must be below half the sampling rate {0.5 * fs:g} Hz")
     sos = butter(order, cutoff_hz, fs=fs, output="sos")
-    padlen = min(3 * (2 * len(sos) + 1), signal.shape[0] - 1)
+    # pad by a fixed time (not a fixed sample count) so the edge treatment does not depend on dt
+    padlen = min(int(round(0.25 * fs)), signal.shape[0] - 1)
     return sosfiltfilt(sos, signal, axis=0, padlen=padlen)
 
 
