@@ -178,9 +178,11 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
 
 
 def coupled_equilibrium(structure: CatenaryStructure, q: np.ndarray, extra=None, rtol: float = 1e-10,
-                        max_iterations: int = 40) -> np.ndarray:
+                        max_iterations: int = 40, xtol: float = 1e-11) -> np.ndarray:
     """Static equilibrium of the assembled catenary by Newton's method (tangent with the
-    current dropper states, backtracking on the residual norm).
+    current dropper states, backtracking on the residual norm). Converged when the residual
+    is below ``rtol`` times the largest load, or when a full step moves no coordinate by more
+    than ``xtol`` (m) (the residual then sits at round-off of the wire tensions).
 
     ``extra(q) -> (force, stiffness)`` adds further forces (e.g. pantograph contact) and their
     ``-d force/d q`` (sparse, n x n, or None).
@@ -214,6 +216,8 @@ def coupled_equilibrium(structure: CatenaryStructure, q: np.ndarray, extra=None,
                 break
             alpha *= 0.5
         q, r = trial, r_trial
+        if alpha == 1.0 and np.abs(dq).max() < xtol and np.abs(r).max() < 1e-6 * scale:
+            return q
     if np.abs(r).max() < 1e-6 * scale:
         return q
     raise SolverError(f"catenary static equilibrium: residual {np.abs(r).max():.3g} N after {max_iterations} "
