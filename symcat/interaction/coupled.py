@@ -109,6 +109,7 @@ class CoupledLine:
         self.C = sps.block_diag([c_cat] + [b[1] for b in blocks], format="csc")
         self.K = sps.block_diag([k_cat] + [b[2] for b in blocks], format="csc")
         self.C_cat = c_cat.tocsr()
+        self.M_csr, self.C_csr = self.M.tocsr(), self.C.tocsr()  # faster products in the time loop
         self.K_panto = [b[2] for b in blocks]
         self.C_panto = [b[1] for b in blocks]
         self.f_panto = [r.pantograph.static_force(self.speed) for r in self.runs]
@@ -216,7 +217,7 @@ class CoupledLine:
     def dissipation_power(self, y_dot: np.ndarray) -> float:
         """Power dissipated by Rayleigh and pantograph dampers (W); dropper and contact
         dampers are not included."""
-        return float(y_dot @ (self.C @ y_dot))
+        return float(y_dot @ (self.C_csr @ y_dot))
 
     # --- static equilibrium ---------------------------------------------------------------
     def _place_pantographs(self, y: np.ndarray, load: np.ndarray) -> None:

@@ -213,7 +213,7 @@ def _step(line: CoupledLine, st: _Stepper, coef: AlphaParameters, t, y, v, acc, 
         v1 = base_v + h * gamma * a1
         states = line.contact_states(y1, v1, t1)
         f, states, fc = line.forces(y1, v1, t1, states, lam1 if bilateral else None)
-        r = line.M @ acc1 - f
+        r = line.M_csr @ acc1 - f
         if z is None:  # S^-1 g of every contact (the point moves little within a step)
             z = st.influence(states)
         g_rows = [s.g_index for s in states]
