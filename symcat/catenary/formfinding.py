@@ -178,7 +178,7 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
 
 
 def coupled_equilibrium(structure: CatenaryStructure, q: np.ndarray, extra=None, rtol: float = 1e-10,
-                        max_iterations: int = 40, xtol: float = 1e-11) -> np.ndarray:
+                        max_iterations: int = 40, xtol: float = 1e-8) -> np.ndarray:
     """Static equilibrium of the assembled catenary by Newton's method (tangent with the
     current dropper states, backtracking on the residual norm). Converged when the residual
     is below ``rtol`` times the largest load, or when a full step moves no coordinate by more

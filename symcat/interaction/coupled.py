@@ -276,11 +276,13 @@ class CoupledLine:
                 return y, fc
             if self.contact == "penalty":
                 dy = spla.spsolve(k.tocsc(), f)
-                y += dy
             else:
                 kkt = sps.bmat([[k.tocsc(), g.tocsc()], [g.T.tocsc(), None]], format="csc")
                 sol = spla.spsolve(kkt, np.concatenate([f, -delta]))
-                y += sol[: self.n]
+                dy = sol[: self.n]
                 lam = lam + sol[self.n:]
+            y += dy
+            if np.abs(dy).max() < 1e-8 and np.abs(f).max() < 1e-6 * scale:  # at round-off
+                return y, self.forces(y, zero, 0.0, None, lam if self.contact == "bilateral" else None)[2]
         raise SolverError(f"static equilibrium with pantographs: residual {np.abs(f).max():.3g} N after {max_iterations} "
                           "iterations; check the pantograph start positions and uplift forces")
