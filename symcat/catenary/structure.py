@@ -271,7 +271,3 @@ class CatenaryStructure:
     def contact_wire_z(self, q: np.ndarray) -> np.ndarray:
         """Contact-wire heights at the stations (m)."""
         return q[self.cw_xyz[:, 2]]
-
-    def element_of(self, x: float) -> int:
-        """Index of the contact-wire element whose reference span contains ``x``."""
-        return int(np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, len(self.x) - 2))
