@@ -11,25 +11,15 @@ import casadi as ca
 import numpy as np
 
 from ..codegen.library import kernel_library, library_interface
-from ..errors import ParameterError
 from ..scene.contact import PenaltyContact
 from ..scene.joints import unit
-from ..scene.rigid import RigidBody
 
 
 def add_contact(model, contact: PenaltyContact):
     """Record of one contact for ``model`` (a :class:`MultibodyModel` under construction)."""
-    from .multibody import Sliding
+    from .multibody import Sliding, wire_attachment
 
-    wire = model.scene.find(contact.wire)
-    body = model.scene.find(contact.body)
-    if not isinstance(body, RigidBody):
-        raise ParameterError(f"contact {contact.name!r}: body={contact.body!r} must be a rigid body")
-    if wire.element.name not in ("cable3d", "beam3d"):
-        raise ParameterError(f"contact {contact.name!r}: wire {wire.name!r} is {wire.element.name}; a contact needs cable3d or beam3d")
-    starts = np.concatenate([[0.0], np.cumsum(wire.params[:, 0])])
-    if not 0 <= contact.s0 <= starts[-1]:
-        raise ParameterError(f"contact {contact.name!r}: s0={contact.s0:g} m must lie on the wire, in [0, {starts[-1]:g}] m")
+    wire, body, starts = wire_attachment(model.scene, "contact", contact.name, contact.wire, contact.body, contact.s0)
     library = f"contact_{wire.element.name}_rigid"
     info = library_interface(library)
     u = body.local(body.position if contact.at is None else contact.at)

@@ -65,6 +65,21 @@ class Sliding:
     window: tuple[int, int] = (0, 0)
 
 
+def wire_attachment(scene, kind: str, name: str, wire_name: str, body_name: str, s0: float):
+    """Check a rigid body attached to an ANCF wire at arc length ``s0`` (sliding joint or
+    contact); returns the wire, the body and the arc length at each element start (m)."""
+    wire = scene.find(wire_name)
+    body = scene.find(body_name)
+    if not isinstance(body, RigidBody):
+        raise ParameterError(f"{kind} {name!r}: body={body_name!r} must be a rigid body")
+    if wire.element.name not in ("cable3d", "beam3d"):
+        raise ParameterError(f"{kind} {name!r}: wire {wire.name!r} is {wire.element.name}; a {kind} needs cable3d or beam3d")
+    starts = np.concatenate([[0.0], np.cumsum(wire.params[:, 0])])
+    if not 0 <= s0 <= starts[-1]:
+        raise ParameterError(f"{kind} {name!r}: s0={s0:g} m must lie on the wire, in [0, {starts[-1]:g}] m")
+    return wire, body, starts
+
+
 class MultibodyModel:
     """Assembled multibody scene (see the module docstring).
 
@@ -185,16 +200,7 @@ class MultibodyModel:
         self._add(library, joint.name, [a, b], values)
 
     def _add_sliding(self, joint: SlidingJoint):
-        wire = self.scene.find(joint.wire)
-        body = self.scene.find(joint.body)
-        if not isinstance(body, RigidBody):
-            raise ParameterError(f"sliding joint {joint.name!r}: body={joint.body!r} must be a rigid body")
-        if wire.element.name not in ("cable3d", "beam3d"):
-            raise ParameterError(f"sliding joint {joint.name!r}: wire {wire.name!r} is {wire.element.name}; a sliding joint needs cable3d or beam3d")
-        lengths = wire.params[:, 0]
-        starts = np.concatenate([[0.0], np.cumsum(lengths)])
-        if not 0 <= joint.s0 <= starts[-1]:
-            raise ParameterError(f"sliding joint {joint.name!r}: s0={joint.s0:g} m must lie on the wire, in [0, {starts[-1]:g}] m")
+        wire, body, starts = wire_attachment(self.scene, "sliding joint", joint.name, joint.wire, joint.body, joint.s0)
         library = f"sliding_{wire.element.name}_rigid"
         info = library_interface(library)
         point = body.position if joint.at is None else joint.at
