@@ -24,7 +24,12 @@ PARAMETERS = [
               minimum=0.0, exclusive_minimum=True),
     Parameter("n_pantographs", 1, "-", "pantographs on the train (1 or 2)", minimum=1, maximum=2),
     Parameter("spacing_m", 200.0, "m", "distance between the two pantographs", minimum=0.0, exclusive_minimum=True),
-    Parameter("n_spans", 0, "-", "spans of the line; 0: 10 for one pantograph, enough for two", minimum=0, maximum=200),
+    Parameter("n_spans", 0, "-", "spans of the line (of each tension section when tension_sections > 1); 0: 10 for "
+              "one pantograph, enough for two", minimum=0, maximum=200),
+    Parameter("tension_sections", 1, "-", "tension sections, each overlapping the next by three spans (the overlap "
+              "of two 10-span sections is the central 3 of 17 spans: set analysis_spans=3)", minimum=1, maximum=20),
+    Parameter("overlap_raise_m", 0.15, "m", "height of a wire going out of running at the overlap's middle support",
+              minimum=0.0, exclusive_minimum=True),
     Parameter("uplift_N", -1.0, "N", "static uplift; -1: EN 50367 target 0.00097 v^2 + 70 N", minimum=-1.0),
     Parameter("aero_coefficient_N_s2_m2", 0.0, "N s^2/m^2", "aerodynamic uplift on the pan-head, c v^2 (v in m/s)",
               minimum=0.0),
@@ -54,10 +59,11 @@ def design_from(p: dict):
 
     from symcat.catenary.reference import parabolic_presag
 
-    n_spans = p["n_spans"] or (10 if p["n_pantographs"] == 1 else
+    n_spans = p["n_spans"] or (10 if p["n_pantographs"] == 1 or p["tension_sections"] > 1 else
                                spans_needed(55.0, 2, p["spacing_m"], p["analysis_spans"]))
     d = benchmark2015(n_spans)
-    changes = dict(presag=tuple(p["presag_scale"] * s for s in d.presag))
+    changes = dict(presag=tuple(p["presag_scale"] * s for s in d.presag), n_sections=p["tension_sections"],
+                   overlap_raise=p["overlap_raise_m"])
     changes["contact_wire"] = replace(d.contact_wire, tension=p["contact_wire_tension_N"])
     changes["messenger_wire"] = replace(d.messenger_wire, tension=p["messenger_tension_N"])
     if p["dropper_positions_m"].strip():
@@ -82,7 +88,8 @@ def run(p: dict):
     panto = LumpedPantograph(base.masses, base.stiffness, damping, uplift, base.uplift_stage,
                              aero_coefficient=p["aero_coefficient_N_s2_m2"], name=base.name, sources=base.sources)
     result = run_passage(design, [panto] * p["n_pantographs"], speed, spacing=p["spacing_m"], **numerical_options(p))
-    extra = {"speed_kmh": p["speed_kmh"], "uplift_N": uplift, "n_spans": design.n_spans,
+    extra = {"speed_kmh": p["speed_kmh"], "uplift_N": uplift, "n_spans": design.line_spans,
+             "tension_sections": design.n_sections,
              "wave_speed_kmh": design.wave_speed * 3.6}
     return passage_output(result, p, "benchmark2015", extra)
 

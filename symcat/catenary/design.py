@@ -61,16 +61,19 @@ class Wire:
 
 @dataclass(frozen=True)
 class CatenaryDesign:
-    """A simple (stitch-free) catenary over ``n_spans`` equal spans, one tension section.
+    """A simple (stitch-free) catenary of ``n_sections`` tension sections of ``n_spans`` equal spans.
 
     The line runs along +x from the first support at x = 0; z is up, y lateral. The messenger
     wire hangs vertically above the contact wire (both at the stagger offset), the left ends
-    are anchored, the right ends carry the tensions of ideal balance weights.
+    are anchored, the right ends carry the tensions of ideal balance weights. Consecutive
+    tension sections overlap by three spans (:mod:`symcat.catenary.sections`). The geometry
+    methods below (``support_x``, ``target_height``, ...) describe one section from its first
+    support; :meth:`sections` places the sections along the line.
 
     Parameters
     ----------
     n_spans : int
-        Number of spans.
+        Number of spans of each tension section.
     span_length : float
         Distance between supports (m).
     encumbrance : float
@@ -105,6 +108,13 @@ class CatenaryDesign:
         Rayleigh damping C = alpha M + beta K (1/s, s), K the stiffness at static equilibrium.
     gravity : float
         Gravitational acceleration (m/s^2).
+    n_sections : int
+        Number of tension sections (1: a single section, no overlap).
+    overlap_raise : float
+        Height of a wire going out of running above working height at the support where it
+        leaves the overlap's transition span (m).
+    overlap_offset : float
+        Lateral distance between the two contact wires of an overlap (m).
     sources : dict
         Where each value comes from (shown in model summaries).
     """
@@ -130,6 +140,9 @@ class CatenaryDesign:
     rayleigh_alpha: float = 0.0
     rayleigh_beta: float = 0.0
     gravity: float = 9.81
+    n_sections: int = 1
+    overlap_raise: float = 0.15
+    overlap_offset: float = 0.2
     sources: dict = field(default_factory=dict, compare=False)
 
     def __post_init__(self):
@@ -167,12 +180,37 @@ class CatenaryDesign:
         if not abs(self.stagger) < 0.1 * self.span_length:
             raise ParameterError(f"stagger={self.stagger:g} m: must be smaller than a tenth of the span")
         _positive("contact_wire_height", self.contact_wire_height, "m")
+        if int(self.n_sections) != self.n_sections or self.n_sections < 1:
+            raise ParameterError(f"n_sections={self.n_sections}: must be an integer >= 1")
+        if self.n_sections > 1 and self.n_spans < 6:
+            raise ParameterError(f"n_spans={self.n_spans}: with n_sections={self.n_sections} each tension section "
+                                 "needs at least 6 spans (a three-span overlap at each end)")
+        if not 0 < self.overlap_raise < self.encumbrance / 5:
+            raise ParameterError(f"overlap_raise={self.overlap_raise:g} m: must be > 0 and below a fifth of the "
+                                 f"encumbrance ({self.encumbrance / 5:g} m; the wire rises 5 x that to its anchor)")
+        _non_negative("overlap_offset", self.overlap_offset, "m")
 
     # --- derived geometry -----------------------------------------------------------------
     @property
     def length(self) -> float:
-        """Length of the line between the first and last support (m)."""
+        """Length of one tension section between its anchors (m)."""
         return self.n_spans * self.span_length
+
+    @property
+    def line_spans(self) -> int:
+        """Spans of the whole line (sections overlap by three spans)."""
+        return self.n_spans if self.n_sections == 1 else self.n_sections * (self.n_spans - 3) + 3
+
+    @property
+    def line_length(self) -> float:
+        """Length of the whole line between its first and last support (m)."""
+        return self.line_spans * self.span_length
+
+    def sections(self):
+        """The tension sections along the line (:class:`~symcat.catenary.sections.TensionSection`)."""
+        from .sections import line_sections
+
+        return line_sections(self)
 
     @property
     def wave_speed(self) -> float:
@@ -180,7 +218,7 @@ class CatenaryDesign:
         return self.contact_wire.wave_speed
 
     def support_x(self) -> np.ndarray:
-        """Positions of the supports (m)."""
+        """Positions of the supports of a section (m)."""
         return self.span_length * np.arange(self.n_spans + 1)
 
     def dropper_x(self) -> np.ndarray:

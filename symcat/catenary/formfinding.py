@@ -94,6 +94,9 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
               max_iterations: int = 30) -> FormFindingResult:
     """Dropper lengths and static equilibrium for ``design`` (see the module docstring).
 
+    The tension sections of a line are independent until a pantograph couples them, so each
+    is form-found on its own; the final check solves them together.
+
     Raises
     ------
     ParameterError
@@ -101,54 +104,79 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
         contact wire (the design cannot be reached).
     """
     t0 = time.perf_counter()
-    d = design
-    st = CatenaryStructure(d, elements_per_span, element)
-    drop, sup = st.dropper_nodes, st.support_nodes
+    st = CatenaryStructure(design, elements_per_span, element)
+    n_drop, n_inner = design.dropper_x().size, design.n_spans - 1
+    lengths, iterations = [], 0
+    for k, sec in enumerate(st.sections):
+        out = _form_section(st, k, tol, max_iterations)
+        lengths.append(out[0])
+        rows = slice(k * n_inner, (k + 1) * n_inner)
+        st.cw_supports.preload[rows], st.mw_supports.preload[rows], st.mw_supports.height[rows] = out[1:4]
+        iterations = max(iterations, out[4])
+    length0 = np.concatenate(lengths)
+    st._build_system()
+    st.set_dropper_lengths(length0)
+    q = coupled_equilibrium(st, st.q0)
+    nodes = np.concatenate([st.dropper_nodes, st.cw_supports.nodes])
+    height_error = float(np.max(np.abs(st.contact_wire_z(q)[nodes] - st.target_z[nodes])))
+    _, _, tension = st.dropper_state(q)
+    return FormFindingResult(st, q, length0, tension, height_error, iterations, time.perf_counter() - t0)
+
+
+def _form_section(st: CatenaryStructure, k: int, tol: float, max_iterations: int):
+    """Form finding of tension section ``k`` (steps 1-3); returns the unstretched dropper
+    lengths, the steady-arm and messenger-support preloads, the messenger support heights and
+    the number of iterations."""
+    d = st.design
+    sec = st.sections[k]
+    cw_body, mw_body = st.contacts[k], st.messengers[k]
+    drop, sup = st._local["drop"], st._local["support"]
     inner = sup[1:-1]
-    n_nodes = st.x.size
+    n_nodes = cw_body.n_nodes
     pos = lambda nodes: nodes[:, :3]
     direction = np.tile([0.0, 0.0, 1.0], (drop.size, 1))
     tension = np.zeros(drop.size)
     length0 = np.full(drop.size, d.encumbrance)
-    beam_extra = ["z_y", "y_z"] if element == "beam3d" else []
+    beam_extra = ["z_y", "y_z"] if st.element == "beam3d" else []
+    support_height = sec.messenger_support_height()
     last_change = np.inf
     for iteration in range(1, max_iterations + 1):
         half = 0.5 * d.dropper_mass_per_length * length0 * d.gravity
         # 1. contact wire held at the design height at droppers and supports
         fixed = [(0, ["x", "y", "z"] + beam_extra), (n_nodes - 1, ["x", "y", "z"])]
-        fixed += [(k, ["x", "y", "z"]) for k in inner] + [(k, ["x", "z"]) for k in drop]
-        fixed += [(k, ["x"]) for k in np.setdiff1d(np.arange(1, n_nodes - 1), np.concatenate([inner, drop]))]
+        fixed += [(j, ["x", "y", "z"]) for j in inner] + [(j, ["x", "z"]) for j in drop]
+        fixed += [(j, ["x"]) for j in np.setdiff1d(np.arange(1, n_nodes - 1), np.concatenate([inner, drop]))]
         loads = [(n_nodes - 1, (d.contact_wire.tension, 0.0, 0.0))]
-        for k, node in enumerate(drop):
-            w = -(d.clamp_mass_contact * d.gravity + half[k])
-            loads.append((node, (tension[k] * direction[k, 0], tension[k] * direction[k, 1], w)))
+        for j, node in enumerate(drop):
+            w = -(d.clamp_mass_contact * d.gravity + half[j])
+            loads.append((node, (tension[j] * direction[j, 0], tension[j] * direction[j, 1], w)))
         for node in inner:
             loads.append((node, (0.0, 0.0, -d.steady_arm_mass * d.gravity)))
-        cw, cw_react, _ = _solve_wire(st.contact, fixed, loads, d.gravity)
+        cw, cw_react, _ = _solve_wire(cw_body, fixed, loads, d.gravity)
         vertical = cw_react[drop, 2]
         tension = vertical / direction[:, 2]
         if np.any(tension <= 0):
-            k = int(np.argmin(tension))
+            j = int(np.argmin(tension))
+            what = "presag or overlap_raise" if (sec.lift_start or sec.lift_end) else "presag"
             raise ParameterError(
-                f"presag: the target needs the dropper at x={d.dropper_x()[k]:g} m in compression "
-                f"(tension {tension[k]:.1f} N); reduce the presag or its curvature")
+                f"{what}: the target needs the dropper at x={sec.dropper_x()[j]:g} m in compression "
+                f"(tension {tension[j]:.1f} N); reduce the {what} or its curvature")
         # 2. messenger under the dropper tensions
-        fixed = [(0, ["x", "y", "z"] + beam_extra), (n_nodes - 1, ["x", "y", "z"])] + [(k, ["x", "y", "z"]) for k in inner]
-        fixed += [(k, ["x"]) for k in np.setdiff1d(np.arange(1, n_nodes - 1), inner)]
+        fixed = [(0, ["x", "y", "z"] + beam_extra), (n_nodes - 1, ["x", "y", "z"])] + [(j, ["x", "y", "z"]) for j in inner]
+        fixed += [(j, ["x"]) for j in np.setdiff1d(np.arange(1, n_nodes - 1), inner)]
         loads = [(n_nodes - 1, (d.messenger_wire.tension, 0.0, 0.0))]
-        for k, node in enumerate(drop):
-            w = -(d.clamp_mass_messenger * d.gravity + half[k])
-            loads.append((node, tuple(-tension[k] * direction[k] + np.array([0.0, 0.0, w]))))
-        mw_start = copy.deepcopy(st.messenger)
-        mw_start.q0[inner, 2] = d.contact_wire_height + d.encumbrance
-        mw_start.q0[[0, -1], 2] = d.contact_wire_height + d.encumbrance
+        for j, node in enumerate(drop):
+            w = -(d.clamp_mass_messenger * d.gravity + half[j])
+            loads.append((node, tuple(-tension[j] * direction[j] + np.array([0.0, 0.0, w]))))
+        mw_start = copy.deepcopy(mw_body)
+        mw_start.q0[sup, 2] = support_height
         mw, mw_react, _ = _solve_wire(mw_start, fixed, loads, d.gravity)
         delta = pos(mw)[drop] - pos(cw)[drop]
         distance = np.linalg.norm(delta, axis=1)
         if np.any(delta[:, 2] <= 0):
-            k = int(np.argmin(delta[:, 2]))
+            j = int(np.argmin(delta[:, 2]))
             raise ParameterError(
-                f"encumbrance={d.encumbrance:g} m: the messenger sags below the contact wire at x={d.dropper_x()[k]:g} m; "
+                f"encumbrance={d.encumbrance:g} m: the messenger sags below the contact wire at x={sec.dropper_x()[j]:g} m; "
                 "increase the encumbrance or the messenger tension")
         direction = delta / distance[:, None]
         tension = vertical / direction[:, 2]
@@ -158,23 +186,12 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
             raise ParameterError("dropper_stiffness: a dropper stretches beyond its own length; increase it")
         last_change = np.max(np.abs(new_length0 - length0))
         length0 = new_length0
-        _balance_axial_forces(st.contact, cw, cw_react[:, 0], d.contact_wire)
-        _balance_axial_forces(st.messenger, mw, mw_react[:, 0], d.messenger_wire)
-        st.mw_supports.preload = mw_react[inner, 2].copy()
-        st.cw_supports.preload = cw_react[inner, 2].copy()
+        _balance_axial_forces(cw_body, cw, cw_react[:, 0], d.contact_wire)
+        _balance_axial_forces(mw_body, mw, mw_react[:, 0], d.messenger_wire)
         if last_change < tol:
-            break
-    else:
-        raise SolverError(f"form finding: dropper lengths still changed by {last_change:.3g} m after "
-                          f"{max_iterations} iterations (tol={tol:g} m)")
-    st.mw_supports.height = mw[inner, 2].copy()
-    st._build_system()
-    st.set_dropper_lengths(length0)
-    q = coupled_equilibrium(st, st.q0)
-    target = d.target_height(st.x[np.concatenate([drop, inner])])
-    height_error = float(np.max(np.abs(st.contact_wire_z(q)[np.concatenate([drop, inner])] - target)))
-    _, _, tension = st.dropper_state(q)
-    return FormFindingResult(st, q, length0, tension, height_error, iteration, time.perf_counter() - t0)
+            return length0, cw_react[inner, 2].copy(), mw_react[inner, 2].copy(), mw[inner, 2].copy(), iteration
+    raise SolverError(f"form finding: dropper lengths of tension section {k + 1} still changed by {last_change:.3g} m "
+                      f"after {max_iterations} iterations (tol={tol:g} m)")
 
 
 def coupled_equilibrium(structure: CatenaryStructure, q: np.ndarray, extra=None, rtol: float = 1e-10,

@@ -73,7 +73,7 @@ class Supports:
 
 
 class CatenaryStructure:
-    """The catenary meshed and assembled.
+    """The catenary meshed and assembled: every tension section's contact and messenger wire.
 
     Parameters
     ----------
@@ -89,64 +89,89 @@ class CatenaryStructure:
     Attributes
     ----------
     x : ndarray
-        Stations (m). ``dropper_nodes`` and ``support_nodes`` index into it.
-    contact, messenger : AncfBody
+        Stations (m) of all sections, section after section (so not sorted where sections
+        overlap). Row ``i`` of ``cw_xyz`` / ``mw_xyz`` holds the coordinates of the contact /
+        messenger wire node at station ``i``; ``dropper_nodes`` and ``support_nodes`` index
+        these rows.
+    sections : list of TensionSection
+        Where each section lies; ``section_rows[k]`` is its slice of the rows.
+    contacts, messengers : list of AncfBody
+        The wires of each section.
     system : System
-        The two wires assembled (elastic forces, mass matrix, gravity and end tensions).
+        The wires assembled (elastic forces, mass matrix, gravity and end tensions).
     dropper_length : ndarray
         Unstretched dropper lengths (m); set by form finding.
+    target_z : ndarray
+        Design contact-wire height at every station (m).
     """
 
     def __init__(self, design: CatenaryDesign, elements_per_span: int, element: str = "cable3d",
                  messenger_z: np.ndarray | None = None):
         self.design = design
         self.element = element
-        self.x = stations(design, elements_per_span)
-        self.elements_per_span = (len(self.x) - 1) // design.n_spans
-        self.dropper_nodes = np.searchsorted(self.x, design.dropper_x() - 1e-9)
-        self.support_nodes = np.searchsorted(self.x, design.support_x() - 1e-9)
         d = design
-        y = d.stagger_y(self.x)
-        z_cw = d.target_height(self.x)
+        local = stations(design, elements_per_span)
+        self.elements_per_span = (len(local) - 1) // design.n_spans
+        self.sections = design.sections()
+        n_local = local.size
+        self.section_rows = [slice(k * n_local, (k + 1) * n_local) for k in range(len(self.sections))]
+        self.x = np.concatenate([sec.x0 + local for sec in self.sections])
+        drop_local = np.searchsorted(local, design.dropper_x() - 1e-9)
+        sup_local = np.searchsorted(local, design.support_x() - 1e-9)
+        starts = n_local * np.arange(len(self.sections))
+        self.dropper_nodes = (starts[:, None] + drop_local[None, :]).ravel()
+        self.support_nodes = (starts[:, None] + sup_local[None, :]).ravel()
+        inner = (starts[:, None] + sup_local[None, 1:-1]).ravel()
+        self._local = dict(drop=drop_local, support=sup_local)
+        y = np.concatenate([sec.stagger_y(sec.x0 + local) for sec in self.sections])
+        z_cw = np.concatenate([sec.target_height(sec.x0 + local) for sec in self.sections])
+        mw_support = np.concatenate([sec.messenger_support_height() for sec in self.sections])
         if messenger_z is None:
             w = d.gravity * (d.contact_wire.mass_per_length + d.messenger_wire.mass_per_length)
-            local = self.x - d.span_length * np.minimum(np.floor(self.x / d.span_length), d.n_spans - 1)
-            sag = w * local * (d.span_length - local) / (2 * d.messenger_wire.tension)
-            messenger_z = d.contact_wire_height + d.encumbrance - sag
-        self.contact = _wire_body("contact", element, self.x, y, z_cw, d.contact_wire)
-        self.messenger = _wire_body("messenger", element, self.x, y, np.asarray(messenger_z, float), d.messenger_wire)
+            span_local = local - d.span_length * np.minimum(np.floor(local / d.span_length), d.n_spans - 1)
+            sag = w * span_local * (d.span_length - span_local) / (2 * d.messenger_wire.tension)
+            messenger_z = np.concatenate([np.interp(sec.x0 + local, sec.support_x(), sec.messenger_support_height()) - sag
+                                          for sec in self.sections])
+        messenger_z = np.asarray(messenger_z, float)
+        self.target_z = z_cw
+        single = len(self.sections) == 1
+        name = lambda base, k: base if single else f"{base}_{k + 1}"
+        self.contacts = [_wire_body(name("contact", k), element, self.x[r], y[r], z_cw[r], d.contact_wire)
+                         for k, r in enumerate(self.section_rows)]
+        self.messengers = [_wire_body(name("messenger", k), element, self.x[r], y[r], messenger_z[r], d.messenger_wire)
+                           for k, r in enumerate(self.section_rows)]
         self.dropper_length = np.full(self.dropper_nodes.size, np.nan)
-        self.cw_supports = Supports(self.support_nodes[1:-1], d.steady_arm_stiffness, z_cw[self.support_nodes[1:-1]],
-                                    np.zeros(d.n_spans - 1))
-        self.mw_supports = Supports(self.support_nodes[1:-1], d.messenger_support_stiffness,
-                                    np.full(d.n_spans - 1, d.contact_wire_height + d.encumbrance), np.zeros(d.n_spans - 1))
+        inner_sup = np.concatenate([np.arange(k * sup_local.size, (k + 1) * sup_local.size)[1:-1]
+                                    for k in range(len(self.sections))])
+        self.cw_supports = Supports(inner, d.steady_arm_stiffness, z_cw[inner], np.zeros(inner.size))
+        self.mw_supports = Supports(inner, d.messenger_support_stiffness, mw_support[inner_sup], np.zeros(inner.size))
         self._build_system()
 
     # --- assembly -------------------------------------------------------------------------
     def _build_system(self) -> None:
         d = self.design
-        for body, wire in ((self.contact, d.contact_wire), (self.messenger, d.messenger_wire)):
-            body.fixed.clear()
-            body.pin(0)
-            body.fix(-1, ["y", "z"])
-            for node in self.support_nodes[1:-1]:
-                body.fix(int(node), ["y"])
-            if self.element == "beam3d":
-                body.fix(0, ["z_y", "y_z"])  # torsion about the wire axis
         scene = Scene(gravity=(0.0, 0.0, -d.gravity))
-        scene.add(self.contact)
-        scene.add(self.messenger)
-        scene.add(NodalForce("contact", -1, (d.contact_wire.tension, 0.0, 0.0)))
-        scene.add(NodalForce("messenger", -1, (d.messenger_wire.tension, 0.0, 0.0)))
+        for cw, mw in zip(self.contacts, self.messengers):
+            for body, wire in ((cw, d.contact_wire), (mw, d.messenger_wire)):
+                body.fixed.clear()
+                body.pin(0)
+                body.fix(-1, ["y", "z"])
+                for node in self._local["support"][1:-1]:
+                    body.fix(int(node), ["y"])
+                if self.element == "beam3d":
+                    body.fix(0, ["z_y", "y_z"])  # torsion about the wire axis
+                scene.add(body)
+                scene.add(NodalForce(body.name, -1, (wire.tension, 0.0, 0.0)))
         self.scene = scene
         self.system = System(scene)
         dofs = self.system.dofs
         self.n = dofs.n
         self.free = dofs.free
-        idx = lambda body, nodes, c: np.array([dofs.index(body, int(k), c) for k in nodes], dtype=np.int64)
-        self.cw_xyz = np.stack([idx(self.contact, range(self.contact.n_nodes), c) for c in "xyz"], axis=1)
-        self.mw_xyz = np.stack([idx(self.messenger, range(self.messenger.n_nodes), c) for c in "xyz"], axis=1)
-        self.cw_zx = idx(self.contact, range(self.contact.n_nodes), "z_x")
+        idx = lambda body, c: np.array([dofs.index(body, k, c) for k in range(body.n_nodes)], dtype=np.int64)
+        self.cw_xyz = np.concatenate([np.stack([idx(b, c) for c in "xyz"], axis=1) for b in self.contacts])
+        self.mw_xyz = np.concatenate([np.stack([idx(b, c) for c in "xyz"], axis=1) for b in self.messengers])
+        self.cw_zx = np.concatenate([idx(b, "z_x") for b in self.contacts])
+        self.cw_xx = np.concatenate([idx(b, "x_x") for b in self.contacts])
         self._lumped = self._lumped_masses()
         q = ca.MX.sym("q", self.n)
         self._linear = None
@@ -271,3 +296,10 @@ class CatenaryStructure:
     def contact_wire_z(self, q: np.ndarray) -> np.ndarray:
         """Contact-wire heights at the stations (m)."""
         return q[self.cw_xyz[:, 2]]
+
+    def running_height(self, x: float) -> float:
+        """Design height of the lowest contact wire at ``x`` (m): the wire a pan-head meets."""
+        heights = [float(sec.target_height(x)) for sec in self.sections if sec.covers(x)]
+        if not heights:
+            raise ParameterError(f"x={x:g} m: off the line (0..{self.design.line_length:g} m)")
+        return min(heights)

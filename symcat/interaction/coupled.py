@@ -4,7 +4,9 @@ The unknowns ``y`` are the free catenary coordinates followed by the stage displ
 each pantograph. Pantograph ``p`` runs at ``speed`` from ``x_start``; its pan-head height is
 ``z_ref + u_head`` and its penetration into the wire ``delta = z_head - z_wire(x_c(t))``.
 Contact is either a penalty (``f = max(k delta + c delta', 0)`` while ``delta > 0``) or a
-bilateral constraint ``delta = 0`` with the contact force as multiplier.
+bilateral constraint ``delta = 0`` with the contact force as multiplier. On a line of several
+tension sections a pan-head has one contact candidate per contact wire above it; in an overlap
+it presses on both (penalty contact only).
 """
 from __future__ import annotations
 
@@ -32,7 +34,7 @@ class PantographRun:
 
 @dataclass
 class ContactState:
-    """Contact of one pantograph at one instant."""
+    """Contact of one pantograph with one contact wire at one instant."""
 
     point: WirePoint
     delta: float  # penetration (m), > 0 when pressing into the wire
@@ -40,6 +42,8 @@ class ContactState:
     g: np.ndarray  # d delta / d y on the entries ``g_index``
     g_index: np.ndarray
     slope: float = 0.0  # dz/dx of the wire at the contact point
+    pantograph: int = 0
+    wire: int = 0  # tension section of the contact wire
 
 
 class CoupledLine:
@@ -74,9 +78,12 @@ class CoupledLine:
         if contact_damping < 0:
             raise ParameterError(f"contact_damping={contact_damping:g} N s/m: must be >= 0")
         for k, run in enumerate(runs):
-            if not 0 <= run.x_start <= d.length:
+            if not 0 <= run.x_start <= d.line_length:
                 raise ParameterError(f"pantograph {k + 1} x_start={run.x_start:g} m: off the wire; must be within "
-                                     f"0..{d.length:g} m")
+                                     f"0..{d.line_length:g} m")
+        if contact == "bilateral" and d.n_sections > 1:
+            raise ParameterError(f"contact='bilateral' with n_sections={d.n_sections}: a pan-head cannot stay on both "
+                                 "wires of an overlap; use contact='penalty'")
         self.form, self.structure, self.runs = form, st, list(runs)
         self.speed, self.contact = float(speed), contact
         self.k_c, self.c_c = float(contact_stiffness), float(contact_damping)
@@ -89,12 +96,10 @@ class CoupledLine:
         self.panto_slices = [slice(a, b) for a, b in zip(offsets[:-1], offsets[1:])]
         self.head_index = np.array([s.stop - 1 for s in self.panto_slices], dtype=int)
         self.n = int(offsets[-1])
-        dofs = st.system.dofs
-        body = st.contact
-        nodes = range(body.n_nodes)
-        self.locator = WireLocator(st.cw_xyz[:, 0], [dofs.index(body, k, "x_x") for k in nodes], st.cw_xyz[:, 2],
-                                   st.cw_zx, body.params[:, body.element.param_names.index("length")])
-        self.z_ref = np.array([d.target_height(r.x_start) for r in runs])
+        self.locators = [WireLocator(st.cw_xyz[r, 0], st.cw_xx[r], st.cw_xyz[r, 2], st.cw_zx[r],
+                                     body.params[:, body.element.param_names.index("length")])
+                         for r, body in zip(st.section_rows, st.contacts)]
+        self.z_ref = np.array([st.running_height(r.x_start) for r in runs])
         self._matrices()
 
     # --- constant matrices ----------------------------------------------------------------
@@ -128,31 +133,51 @@ class CoupledLine:
     def contact_states(self, y: np.ndarray, y_dot: np.ndarray, t: float) -> list[ContactState]:
         q = self.catenary_q(y)
         states = []
+        sections = self.structure.sections
         for p, x in enumerate(self.x_contact(t)):
-            point = self.locator.locate(q, x)
-            z_w = point.height(q)
-            head = self.head_index[p]
-            delta = self.z_ref[p] + y[head] - z_w
-            pos = self.in_free[point.index]
-            keep = pos >= 0
-            v_full = np.zeros(4)
-            v_full[keep] = y_dot[pos[keep]]
-            slope = self._slope(q, point)
-            rate = y_dot[head] - point.weights @ v_full - slope * self.speed
-            g_index = np.concatenate([[head], pos[keep]])
-            g = np.concatenate([[1.0], -point.weights[keep]])
-            states.append(ContactState(point, float(delta), float(rate), g, g_index, slope))
+            for w, sec in enumerate(sections):
+                if not sec.covers(x):
+                    continue
+                locator = self.locators[w]
+                point = locator.locate(q, x)
+                z_w = point.height(q)
+                head = self.head_index[p]
+                delta = self.z_ref[p] + y[head] - z_w
+                pos = self.in_free[point.index]
+                keep = pos >= 0
+                v_full = np.zeros(4)
+                v_full[keep] = y_dot[pos[keep]]
+                slope = self._slope(q, point, locator)
+                rate = y_dot[head] - point.weights @ v_full - slope * self.speed
+                g_index = np.concatenate([[head], pos[keep]])
+                g = np.concatenate([[1.0], -point.weights[keep]])
+                states.append(ContactState(point, float(delta), float(rate), g, g_index, slope, p, w))
         return states
 
-    def _slope(self, q: np.ndarray, point: WirePoint) -> float:
+    @staticmethod
+    def _slope(q: np.ndarray, point: WirePoint, locator: WireLocator) -> float:
         """dz/dx of the contact wire at the contact point."""
-        k, length = point.element, self.locator.lengths[point.element]
+        k, length = point.element, locator.lengths[point.element]
         _, dn = hermite(point.xi)
         lz = np.array([1.0, length, 1.0, length])
         cz = q[point.index] * lz
-        ix = [self.locator.x_index[k], self.locator.xx_index[k], self.locator.x_index[k + 1], self.locator.xx_index[k + 1]]
+        ix = [locator.x_index[k], locator.xx_index[k], locator.x_index[k + 1], locator.xx_index[k + 1]]
         cx = q[ix] * lz
         return float((dn @ cz) / (dn @ cx))
+
+    def per_pantograph(self, states: list[ContactState], forces) -> np.ndarray:
+        """Total contact force (N) on each pan-head from per-wire contact forces."""
+        out = np.zeros(len(self.runs))
+        for s, f in zip(states, forces):
+            out[s.pantograph] += f
+        return out
+
+    def per_wire(self, states: list[ContactState], forces) -> np.ndarray:
+        """Contact force (N) of each pan-head on each section's contact wire (n_panto, n_sections)."""
+        out = np.zeros((len(self.runs), len(self.structure.sections)))
+        for s, f in zip(states, forces):
+            out[s.pantograph, s.wire] += f
+        return out
 
     def penalty_force(self, state: ContactState) -> float:
         """Contact force (N, >= 0) of the penalty law."""
@@ -224,10 +249,13 @@ class CoupledLine:
         """Solve the catenary under the static contact forces ``load`` (N) and set each
         pantograph's reference height so that it stands there with exactly that force: the
         static uplift is the static contact force, as the standards define it."""
-        def point_loads(q):  # the contact forces on the wire, at the pan-heads' positions
+        q0 = self.catenary_q(y)
+        wires = [self._running_wire(q0, x) for x in self.x_contact(0.0)]  # fixed: Newton needs a smooth load
+
+        def point_loads(q):  # the contact forces on the running wire, at the pan-heads' positions
             f = np.zeros(self.structure.n)
-            for x, fc in zip(self.x_contact(0.0), load):
-                point = self.locator.locate(q, x)
+            for x, fc, w in zip(self.x_contact(0.0), load, wires):
+                point = self.locators[w].locate(q, x)
                 np.add.at(f, point.index, fc * point.weights)
             return f, None
 
@@ -240,21 +268,32 @@ class CoupledLine:
             u = np.linalg.lstsq(k, rhs, rcond=None)[0]
             y[sl] = u
             gap = load[p] / self.k_c if self.contact == "penalty" else 0.0
-            point = self.locator.locate(q, self.x_contact(0.0)[p])
+            point = self.locators[wires[p]].locate(q, self.x_contact(0.0)[p])
             self.z_ref[p] = point.height(q) + gap - u[-1]
 
-    def static_state(self, rtol: float = 1e-9, max_iterations: int = 40) -> tuple[np.ndarray, np.ndarray]:
+    def _running_wire(self, q: np.ndarray, x: float) -> int:
+        """The section whose contact wire is lowest at ``x`` (the one in running)."""
+        heights = {w: self.locators[w].locate(q, x).height(q) for w, sec in enumerate(self.structure.sections)
+                   if sec.covers(x)}
+        return min(heights, key=heights.get)
+
+    def static_state(self, rtol: float = 1e-9, max_iterations: int = 40,
+                     z_ref: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Static equilibrium with the pantographs pressing at their start positions.
 
         Returns ``(y, contact_forces)``. Newton's method on the tangent with the current dropper
-        states; the bilateral model solves for the multipliers with ``delta = 0``.
+        states; the bilateral model solves for the multipliers with ``delta = 0``. By default
+        each pantograph's reference height is placed so that it presses with its static force;
+        ``z_ref`` (m, one per pantograph) keeps given reference heights instead (a pantograph
+        that has travelled from elsewhere, so its frame spring sets the force).
         """
         y = np.zeros(self.n)
         y[: self.n_cat] = self.q_static[self.free]
         zero = np.zeros(self.n)
-        n_c = len(self.runs)
         lam = np.array([r.pantograph.static_force(self.speed).sum() for r in self.runs], dtype=float)
         self._place_pantographs(y, lam)
+        if z_ref is not None:
+            self.z_ref = np.array(z_ref, dtype=float)
         lam = lam.copy()
         scale = max(1.0, float(np.abs(self.structure._f_ext).max()))
         for it in range(max_iterations):
@@ -265,7 +304,7 @@ class CoupledLine:
                 f, states, fc = self.forces(y, zero, 0.0, states, lam)
             k_cat = self.structure.stiffness(self.catenary_q(y))[self.free][:, self.free]
             k = sps.block_diag([k_cat] + self.K_panto, format="lil")
-            g = sps.lil_matrix((self.n, n_c))
+            g = sps.lil_matrix((self.n, len(states)))
             for p, s in enumerate(states):
                 g[s.g_index, p] = s.g[:, None]
                 if self.contact == "penalty" and s.delta > 0:

@@ -1,4 +1,7 @@
-"""Looking at a passage: PNG plots and a ParaView time series (VTU files + a .pvd index)."""
+"""Looking at a passage: PNG plots and a ParaView time series (VTU files + a .pvd index).
+
+The ParaView ``part_id`` is 0 for contact wires, 1 for messengers, 2 for droppers and 3 for
+pan-heads."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -44,6 +47,11 @@ def plot_passage(result, folder: Path, stem: str = "passage") -> list[Path]:
         f = rec.contact_force_N[:, p]
         ax.plot(x[:, p], f, color="0.6", lw=0.6, label="raw")
         ax.plot(x[:, p], lowpass(rec.t_s, f), color="tab:blue", lw=1.2, label="filtered 20 Hz")
+        per_wire = rec.contact_force_wire_N[:, p, :]
+        if per_wire.shape[1] > 1:  # overlaps: how the force is shared between the wires
+            for w in range(per_wire.shape[1]):
+                if np.any(per_wire[:, w] > 0) and np.any(per_wire[:, w] < f):
+                    ax.plot(x[:, p], per_wire[:, w], lw=0.7, ls="--", label=f"on wire of section {w + 1}")
         _marks(ax, result, x[:, p].min(), x[:, p].max())
         ax.set_ylabel(f"pantograph {p + 1}\ncontact force [N]")
         ax.legend(loc="upper right", fontsize=8)
@@ -106,13 +114,13 @@ def write_paraview_series(result, folder: Path, stem: str = "passage", points_pe
     rec = result.record
     st = result.form.structure
     line = result.line
-    sets = [st.system.body_set("contact"), st.system.body_set("messenger")]
+    sets = [(st.system.body_set(b.name), 0) for b in st.contacts] + [(st.system.body_set(b.name), 1) for b in st.messengers]
     entries = []
     t_all = rec.t_s
     for k, (t, q) in enumerate(zip(rec.snapshot_t_s, rec.snapshot_q)):
         points, cells, kind, value = [], [], [], []
         start = 0
-        for wire_id, es in enumerate(sets):
+        for es, wire_id in sets:
             r, _ = es.sample(q, points_per_element)
             idx = np.arange(start, start + len(r))
             points.append(r)

@@ -55,11 +55,12 @@ SETTLE_S = 0.2
 
 def default_section(design: CatenaryDesign, analysis_spans: int, first_span: int | None = None) -> tuple[float, float]:
     """The central ``analysis_spans`` spans (or those starting at ``first_span``, 0-based)."""
-    if not 1 <= analysis_spans <= design.n_spans:
-        raise ParameterError(f"analysis_spans={analysis_spans}: must be 1..n_spans={design.n_spans}")
-    first = (design.n_spans - analysis_spans) // 2 if first_span is None else first_span
-    if not 0 <= first <= design.n_spans - analysis_spans:
-        raise ParameterError(f"first analysis span {first}: must be 0..{design.n_spans - analysis_spans}")
+    n_spans = design.line_spans
+    if not 1 <= analysis_spans <= n_spans:
+        raise ParameterError(f"analysis_spans={analysis_spans}: must be 1..{n_spans} (the spans of the line)")
+    first = (n_spans - analysis_spans) // 2 if first_span is None else first_span
+    if not 0 <= first <= n_spans - analysis_spans:
+        raise ParameterError(f"first analysis span {first}: must be 0..{n_spans - analysis_spans}")
     return first * design.span_length, (first + analysis_spans) * design.span_length
 
 
@@ -102,11 +103,11 @@ def run_passage(design: CatenaryDesign, pantographs: list[LumpedPantograph], spe
     section = default_section(design, analysis_spans)
     if section[0] - lead_in - gap < 0.5 * L:  # shift the section right to fit the lead-in
         section = default_section(design, analysis_spans, min(int(math.ceil((0.5 * L + lead_in + gap) / L)),
-                                                             design.n_spans - analysis_spans))
+                                                             design.line_spans - analysis_spans))
     x_trail = max(section[0] - lead_in - gap, 0.5 * L)
-    if t_end is None and section[1] + gap > design.length - 0.5 * L:
+    if t_end is None and section[1] + gap > design.line_length - 0.5 * L:
         need = spans_needed(L, len(pantographs), spacing, analysis_spans, lead_in)
-        raise ParameterError(f"n_spans={design.n_spans}: {len(pantographs)} pantograph(s) {spacing:g} m apart with "
+        raise ParameterError(f"n_spans={design.line_spans} (line): {len(pantographs)} pantograph(s) {spacing:g} m apart with "
                              f"{analysis_spans} analysis spans and a {lead_in:g} m lead-in need at least {need} spans")
     x_lead = x_trail + gap
     runs = [PantographRun(p, x_lead - k * spacing) for k, p in enumerate(pantographs)]
@@ -118,11 +119,11 @@ def run_passage(design: CatenaryDesign, pantographs: list[LumpedPantograph], spe
     line = CoupledLine(form, runs, speed, contact, contact_stiffness, contact_damping)
     # run on past the section for the 20 Hz filter to settle: its zero-phase edge treatment
     # would otherwise bend the last 50 ms of the section (an O(dt) drift of the mean, measured)
-    lead_out = min(SETTLE_S * speed, design.length - 0.25 * L - gap - section[1])
+    lead_out = min(SETTLE_S * speed, design.line_length - 0.25 * L - gap - section[1])
     duration = (section[1] + max(lead_out, 0.0) - x_trail) / speed + 1e-9 if t_end is None else float(t_end)
-    if duration > 0 and max(r.x_start for r in runs) + speed * duration > design.length:
+    if duration > 0 and max(r.x_start for r in runs) + speed * duration > design.line_length:
         raise ParameterError(f"t_end={duration:g} s: the leading pantograph would run off the end of the line "
-                             f"({design.length:g} m)")
+                             f"({design.line_length:g} m)")
     if duration == 0:
         y, fc = line.static_state()
         return PassageResult(form, line, None, section, [], time.perf_counter() - t0, 0.0)

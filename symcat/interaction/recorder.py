@@ -17,6 +17,8 @@ class PassageRecorder:
     ----------------------------------------------------
     t_s : (n_steps,)
     x_contact_m, contact_force_N, penetration_m, panhead_z_m, panhead_acc_m_s2 : (n_steps, n_pantographs)
+        (the force is the total on the pan-head; the penetration that of the lowest wire)
+    contact_force_wire_N : (n_steps, n_pantographs, n_sections)  force on each section's wire
     support_z_m : (n_steps, n_supports)   contact-wire height at every support
     dropper_tension_N : (n_steps, n_droppers)
     iterations : (n_steps,)  Newton iterations per step
@@ -28,7 +30,7 @@ class PassageRecorder:
         self.line = line
         self.record_every = record_every
         self._rows: dict[str, list] = {k: [] for k in (
-            "t_s", "x_contact_m", "contact_force_N", "penetration_m", "panhead_z_m", "panhead_acc_m_s2",
+            "t_s", "x_contact_m", "contact_force_N", "contact_force_wire_N", "penetration_m", "panhead_z_m", "panhead_acc_m_s2",
             "support_z_m", "dropper_tension_N", "iterations", "work_power_W", "dissipation_power_W")}
         self._snap_t, self._snap_q, self._snap_u, self._snap_e = [], [], [], []
         self._next_snapshot = 0.0
@@ -41,8 +43,12 @@ class PassageRecorder:
         rows = self._rows
         rows["t_s"].append(t)
         rows["x_contact_m"].append(line.x_contact(t))
-        rows["contact_force_N"].append(np.asarray(contact_forces, float).copy())
-        rows["penetration_m"].append([s.delta for s in states])
+        rows["contact_force_N"].append(line.per_pantograph(states, contact_forces))
+        rows["contact_force_wire_N"].append(line.per_wire(states, contact_forces))
+        deepest = np.full(len(line.runs), -np.inf)
+        for s in states:
+            deepest[s.pantograph] = max(deepest[s.pantograph], s.delta)
+        rows["penetration_m"].append(deepest)
         rows["panhead_z_m"].append(line.z_ref + y[line.head_index])
         rows["panhead_acc_m_s2"].append(acc[line.head_index])
         rows["support_z_m"].append(q[st.cw_xyz[st.support_nodes, 2]])

@@ -118,7 +118,7 @@ def test_wire_locator_matches_compiled_position_kernel(short_line):
 
     st = short_line.structure
     dofs = st.system.dofs
-    body = st.contact
+    body = st.contacts[0]
     lengths = body.params[:, 0]
     loc = WireLocator(st.cw_xyz[:, 0], [dofs.index(body, k, "x_x") for k in range(body.n_nodes)], st.cw_xyz[:, 2],
                       st.cw_zx, lengths)

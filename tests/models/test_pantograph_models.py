@@ -61,3 +61,26 @@ def test_bad_input_names_the_parameter_and_writes_nothing(tmp_path, model, value
     with pytest.raises(ParameterError, match=name):
         run_model(model, {**values, "progress": False}, out=out)
     assert not out.exists()
+
+
+def test_benchmark_over_an_overlap_reports_both_wires(tmp_path):
+    """Two tension sections: the analysis spans cover the overlap; the pan-head presses on both
+    wires somewhere in the transition span and the per-wire forces add up to the total."""
+    import numpy as np
+
+    from symcat.interaction import load_passage
+
+    res = run_model("benchmark2015", {"tension_sections": 2, "n_spans": 6, "analysis_spans": 3, "speed_kmh": 250.0,
+                                      "elements_per_span": 20, "progress": False, "paraview": False}, out=tmp_path)
+    s = res.summary
+    assert s["n_spans"] == 9 and s["tension_sections"] == 2
+    assert s["analysis_section_m"] == [165.0, 330.0]
+    assert 100 < s["contact_force_mean_N"] < 200 and s["contact_loss_percent"] < 20
+    arrays = load_passage(tmp_path / "benchmark2015.npz")
+    wire = arrays["contact_force_wire_N"]
+    assert wire.shape[1:] == (1, 2)
+    assert wire.sum(axis=2) == pytest.approx(arrays["contact_force_N"], abs=1e-9)
+    x = arrays["x_contact_m"][:, 0]
+    both = (wire[:, 0, 0] > 0) & (wire[:, 0, 1] > 0)
+    assert both.any() and np.all((x[both] > 220.0) & (x[both] < 275.0))
+    assert (tmp_path / "benchmark2015_contact_force.png").is_file()
