@@ -65,7 +65,7 @@ def en50318(n_spans: int = 10, presag_max: float = 0.055) -> CatenaryDesign:
     clamp masses (none given: taken as zero), Rayleigh damping fitted to 0.5 % at 1 and 20 Hz,
     and no stagger. ``presag_max`` (m) is the presag at mid-span: the public data give 55 mm
     as a maximum, and the statistics depend on it more than on any other open value (the
-    sensitivity study in ``bench/report/README.md``).
+    sensitivity study in ``models/en50318.py``).
     """
     positions = (5.0, 10.5, 17.0, 23.5, 30.0, 36.5, 43.0, 49.5, 55.0)
     alpha, beta = rayleigh_from_ratio(0.005, 1.0, 20.0)
