@@ -105,7 +105,7 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
     """
     t0 = time.perf_counter()
     st = CatenaryStructure(design, elements_per_span, element)
-    n_drop, n_inner = design.dropper_x().size, design.n_spans - 1
+    n_inner = design.n_spans - 1
     lengths, iterations = [], 0
     for k, sec in enumerate(st.sections):
         out = _form_section(st, k, tol, max_iterations)

@@ -11,8 +11,6 @@ import math
 import time
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from ..catenary.design import CatenaryDesign
 from ..catenary.formfinding import FormFindingResult, find_form
 from ..errors import ParameterError
