@@ -9,6 +9,10 @@ Constraint library ``<c>`` with ``y = [x_i, x_j, s]``:
 ``<c>_gamma(y, y_dot, t, p) -> q_d`` = ``d2c/dt2 - c_y y_ddot`` (the quadratic velocity terms
 of seed eq. 14, including the time terms of driving constraints).
 
+The wheel/rail contact libraries ``wheelrail_global_rigid_ground`` and
+``wheelrail_railframe_rigid_ground`` (:mod:`symcat.symbolic.wheelrail`) are constraint libraries
+of this form, with ``y = [R, theta, s1w, s2w, s1r, s2r]``.
+
 Force library ``<f>``: ``<f>(y, y_dot, t, p) -> q`` (generalized force on ``y``).
 
 Contact library ``contact_<el>_rigid`` with ``y = [e, x_j, s]`` (see
@@ -35,9 +39,12 @@ from ..symbolic.contact import CONTACTS
 from ..symbolic.force_elements import FORCES
 from ..symbolic.joints import CONSTRAINTS
 from ..symbolic.rigid import rigid_body
+from ..symbolic.wheelrail import WHEELRAIL_CONSTRAINTS
 from .sympy_to_casadi import SympyToCasadi, bind
 
 OPTS = {"cse": True}
+#: Every constraint library: the joints plus the wheel/rail contacts (same kernels, ``y = [x_i, x_j, s]``).
+ALL_CONSTRAINTS = {**CONSTRAINTS, **WHEELRAIL_CONSTRAINTS}
 
 
 def _with_jacobian(f: ca.Function) -> list[ca.Function]:
@@ -61,7 +68,7 @@ def rigid_functions() -> list[ca.Function]:
 
 
 def constraint_functions(name: str) -> list[ca.Function]:
-    defn = CONSTRAINTS[name]()
+    defn = ALL_CONSTRAINTS[name]()
     ny = defn.y.rows
     y, y_dot, t, p = ca.SX.sym("y", ny), ca.SX.sym("y_dot", ny), ca.SX.sym("t"), ca.SX.sym("p", defn.p.rows)
     conv = SympyToCasadi({**bind(defn.y, y), **bind(defn.p, p), defn.t: t})
@@ -136,13 +143,13 @@ def contact_functions(name: str) -> list[ca.Function]:
 
 
 def multibody_library_names() -> list[str]:
-    return ["rigid", *sorted(CONSTRAINTS), *sorted(FORCES), *sorted(CONTACTS)]
+    return ["rigid", *sorted(CONSTRAINTS), *sorted(FORCES), *sorted(CONTACTS), *sorted(WHEELRAIL_CONSTRAINTS)]
 
 
 def multibody_functions(name: str) -> list[ca.Function]:
     if name == "rigid":
         return rigid_functions()
-    if name in CONSTRAINTS:
+    if name in ALL_CONSTRAINTS:
         return constraint_functions(name)
     if name in FORCES:
         return force_functions(name)
@@ -161,9 +168,9 @@ def interface(name: str) -> dict:
         defn = CONTACTS[name]()
         return {"kind": "contact", "params": defn.param_names + list(CONTACT_LAW), "n_i": defn.e.rows,
                 "n_j": defn.x_j.rows, "n_s": 1}
-    defn = CONSTRAINTS[name]() if name in CONSTRAINTS else FORCES[name]()
-    out = {"kind": "constraint" if name in CONSTRAINTS else "force", "params": defn.param_names,
+    defn = ALL_CONSTRAINTS[name]() if name in ALL_CONSTRAINTS else FORCES[name]()
+    out = {"kind": "constraint" if name in ALL_CONSTRAINTS else "force", "params": defn.param_names,
            "n_i": defn.x_i.rows, "n_j": defn.x_j.rows}
-    if name in CONSTRAINTS:
+    if name in ALL_CONSTRAINTS:
         out.update(n_s=defn.s.rows, n_c=defn.c.rows)
     return out

@@ -1,0 +1,393 @@
+"""Constraint contact of one wheel of a rigid wheelset on its rail (seed eqs. 15-22), at run time.
+
+The compiled kernels ``wheelrail_global_rigid_ground`` (eq. 21) and
+``wheelrail_railframe_rigid_ground`` (eq. 22) are exact on one cubic piece of each profile (see
+:mod:`symcat.symbolic.wheelrail` for the surfaces, frames and parameter layout). This module
+picks the pieces that contain the current surface parameters, passes their coefficients and
+evaluates ``C``, ``C_q``, ``C_s``, ``C_t`` and ``Q_d``; and it locates the contact point of a
+given wheelset position (the geometric solve of the embedded formulation) by Newton's method.
+
+Frames (as :mod:`.geometry`, extended to 3D): global ``x`` along the track, ``y`` toward the
+left rail, ``z`` up, origin on the track centre line at rail-top level. Wheelset coordinates
+``q = [R, theta]``: ``R`` the axle centre (m), ``theta`` Euler parameters, axle along the body
+``y`` axis. Surface parameters ``s = [s1w, s2w, s1r, s2r]``: wheel profile parameter (m), angle
+about the axle from the bottom of the wheel (rad, positive toward body ``+x``), distance along
+the track (m), rail profile parameter (m).
+
+Only tangent track for now: the rail profile frame is ``R^rp = [s1r, Y_o, Z_o]``,
+``A^rp = R_x(cant + side * (inclination - built-in inclination))``; a curved track would pass
+its local frame pieces the same way as the profiles' (hook in
+:func:`symcat.symbolic.wheelrail.tangent_track_frame`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from symcat.errors import ParameterError, SolverError
+
+from .geometry import TrackCrossSection, WheelsetDimensions, gauge_point
+from .profiles import Profile
+
+SIDES = {"left": 1.0, "right": -1.0}
+FORMS = ("global", "railframe")
+N_PARAMS = 24
+#: Largest Newton step per surface parameter: s1w, s2w, s1r, s2r [m, rad, m, m].
+MAX_STEP = np.array([2e-3, 0.02, 5e-3, 2e-3])
+
+
+def library_name(form: str) -> str:
+    """Kernel library of a constraint form (``"global"``: eq. 21, ``"railframe"``: eq. 22)."""
+    if form not in FORMS:
+        raise ParameterError(f"form={form!r}: must be one of {', '.join(FORMS)}")
+    return f"wheelrail_{form}_rigid_ground"
+
+
+@dataclass
+class ContactKernels:
+    """Constraint values and derivatives at one state (5 rows each).
+
+    Attributes
+    ----------
+    c : ndarray (5,)
+        Constraint values (m for the point rows, - for the tangency rows).
+    C_q : ndarray (5, 7)
+        Jacobian with respect to the wheelset coordinates ``[R, theta]``.
+    C_s : ndarray (5, 4)
+        Jacobian with respect to the surface parameters.
+    C_t : ndarray (5,)
+        Partial time derivative (zero: the rail is fixed).
+    Q_d : ndarray (5,)
+        ``d2C/dt2 - C_q q_ddot - C_s s_ddot`` (quadratic velocity terms, seed eq. 14).
+    """
+
+    c: np.ndarray
+    C_q: np.ndarray
+    C_s: np.ndarray
+    C_t: np.ndarray
+    Q_d: np.ndarray | None = None
+
+
+@dataclass
+class ContactPoint:
+    """Solution of the contact-point problem for a given wheelset position.
+
+    Attributes
+    ----------
+    s : ndarray (4,)
+        Surface parameters ``[s1w, s2w, s1r, s2r]``.
+    gap_m : float
+        Normal gap along the rail's outward normal [m] (positive: separated, negative:
+        penetration); the fifth constraint's value.
+    rolling_radius_m : float
+        Wheel radius at the contact point [m].
+    contact_angle_rad : float
+        Inclination of the common tangent to the track plane [rad], positive when the wheel's
+        contact normal points toward the track centre (convention of :mod:`.geometry`).
+    wheel_y_m, rail_y_m : float
+        Lateral coordinates of the contact point on the wheel and rail profiles [m].
+    point_m : ndarray (3,)
+        Contact point on the rail, global [m].
+    normal : ndarray (3,)
+        Unit outward normal of the rail, global.
+    residual : float
+        Largest absolute value of the four conditions solved.
+    iterations : int
+        Newton iterations.
+    """
+
+    s: np.ndarray
+    gap_m: float
+    rolling_radius_m: float
+    contact_angle_rad: float
+    wheel_y_m: float
+    rail_y_m: float
+    point_m: np.ndarray
+    normal: np.ndarray
+    residual: float
+    iterations: int
+
+
+def _np(x) -> np.ndarray:
+    return np.asarray(x.full() if hasattr(x, "full") else x, float)
+
+
+def _rot_x(a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+class WheelRailContact:
+    """One wheel/rail contact of a rigid wheelset on tangent track (constraint formulation).
+
+    Parameters
+    ----------
+    wheel, rail : Profile
+        Wheel and rail profiles in the frames of :mod:`.profiles` (the same profiles serve either
+        side: they are mirrored on the right, as in :mod:`.geometry`).
+    side : str
+        ``"left"`` (wheel on the body ``+y`` end of the axle, rail at global ``y > 0``) or
+        ``"right"``.
+    wheelset : WheelsetDimensions, optional
+        Tape-circle distance and nominal rolling radius (default 1.5 m, 0.46 m).
+    track : TrackCrossSection, optional
+        Gauge, gauge depth and rail inclination (default 1.435 m, 14 mm, as built into the rail
+        profile); the rails are placed exactly as by :func:`.geometry.contact_geometry`.
+    cant_rad : float
+        Cant: rotation of the whole cross-section about the track centre line [rad], positive
+        raising the left rail.
+    form : str
+        ``"railframe"`` (eq. 22, default) or ``"global"`` (eq. 21).
+    """
+
+    def __init__(self, wheel: Profile, rail: Profile, side: str, *, wheelset: WheelsetDimensions | None = None,
+                 track: TrackCrossSection | None = None, cant_rad: float = 0.0, form: str = "railframe"):
+        if side not in SIDES:
+            raise ParameterError(f"side={side!r}: must be 'left' or 'right'")
+        for prof, kind in ((wheel, "wheel"), (rail, "rail")):
+            if not isinstance(prof, Profile) or prof.kind != kind:
+                raise ParameterError(f"{kind}={prof!r}: must be a {kind} Profile")
+        if not (isinstance(cant_rad, (int, float)) and abs(cant_rad) < 0.3):
+            raise ParameterError(f"cant_rad={cant_rad!r}: must be a number with |cant_rad| < 0.3 rad")
+        self.wheelset = wheelset or WheelsetDimensions()
+        self.track = track or TrackCrossSection()
+        for label, value in (("tape_circle_distance_m", self.wheelset.tape_circle_distance_m),
+                             ("nominal_radius_m", self.wheelset.nominal_radius_m), ("gauge_m", self.track.gauge_m)):
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ParameterError(f"{label}={value!r}: must be a number > 0")
+        self.form = form
+        self.library = library_name(form)
+        self.side = side
+        self.sign = SIDES[side]
+        self.wheel, self.rail = wheel, rail
+        self.cant_rad = float(cant_rad)
+        incl = self.track.rail_inclination_rad
+        extra = 0.0 if incl is None else incl - rail.inclination_rad
+        installed = rail.transformed(extra) if extra else rail
+        origin = 0.5 * self.track.gauge_m - gauge_point(installed, self.track.gauge_depth_m)[0]
+        self.rail_origin_m = _rot_x(self.cant_rad) @ np.array([0.0, self.sign * origin, 0.0])
+        self.profile_roll_rad = self.sign * extra  # relative to the track plane
+        self._roll = self.cant_rad + self.profile_roll_rad
+        self._wpp = wheel.piecewise_polynomial()
+        self._rpp = rail.piecewise_polynomial()
+        self._head = np.array([self.sign, self.wheelset.nominal_radius_m, 0.5 * self.wheelset.tape_circle_distance_m,
+                               self.rail_origin_m[1], self.rail_origin_m[2], self._roll])
+        self._kernels = None
+
+    # ------------------------------------------------------------------ kernels
+    @property
+    def kernels(self):
+        if self._kernels is None:
+            from symcat.codegen.library import kernel_library
+
+            self._kernels = kernel_library(self.library)
+        return self._kernels
+
+    @staticmethod
+    def _piece(pp, s: float, label: str, profile: Profile, clip: bool) -> int:
+        x = pp.x
+        if not clip and not (x[0] - 1e-9 <= s <= x[-1] + 1e-9):
+            raise ParameterError(f"{label}={s:.6g} m: outside the {profile.kind} profile {profile.name!r} "
+                                 f"(allowed {x[0]:.6g} to {x[-1]:.6g} m)")
+        return int(np.clip(np.searchsorted(x, s, side="right") - 1, 0, len(x) - 2))
+
+    def parameters(self, s, *, pieces: tuple[int, int] | None = None, clip: bool = False) -> np.ndarray:
+        """Kernel parameters (24) for surface parameters ``s``: the spline pieces containing
+        ``s1w`` and ``s2r`` (or the given ``pieces = (wheel, rail)`` indices)."""
+        s = np.asarray(s, float)
+        if pieces is None:
+            iw = self._piece(self._wpp, s[0], "s1w", self.wheel, clip)
+            ir = self._piece(self._rpp, s[3], "s2r", self.rail, clip)
+        else:
+            iw, ir = pieces
+        cw, cr = self._wpp.c[:, iw, :], self._rpp.c[:, ir, :]
+        return np.r_[self._head, self._wpp.x[iw], cw[:, 0], cw[:, 1], self._rpp.x[ir], cr[:, 0], cr[:, 1]]
+
+    def residual(self, q, s, t: float = 0.0, **kw) -> np.ndarray:
+        """The five constraints ``C(q, s)``."""
+        y = np.r_[np.asarray(q, float), np.asarray(s, float)]
+        return _np(self.kernels[f"{self.library}_c"](y, t, self.parameters(s, **kw))).ravel()
+
+    def evaluate(self, q, s, q_dot=None, s_dot=None, t: float = 0.0, **kw) -> ContactKernels:
+        """``C``, ``C_q``, ``C_s``, ``C_t`` and (with velocities) ``Q_d`` at one state."""
+        q, s = np.asarray(q, float), np.asarray(s, float)
+        if q.shape != (7,) or s.shape != (4,):
+            raise ParameterError(f"q, s: shapes {q.shape}, {s.shape}; must be (7,) and (4,)")
+        y = np.r_[q, s]
+        p = self.parameters(s, **kw)
+        lib = self.kernels
+        c = _np(lib[f"{self.library}_c"](y, t, p)).ravel()
+        c_y, c_t = (_np(m) for m in lib[f"{self.library}_jac"](y, t, p))
+        c_y = c_y.reshape(5, 11)
+        q_d = None
+        if q_dot is not None or s_dot is not None:
+            y_dot = np.r_[np.zeros(7) if q_dot is None else q_dot, np.zeros(4) if s_dot is None else s_dot]
+            q_d = _np(lib[f"{self.library}_gamma"](y, y_dot, t, p)).ravel()
+        return ContactKernels(c, c_y[:, :7], c_y[:, 7:], c_t.ravel(), q_d)
+
+    # ------------------------------------------------------------------ contact point
+    def initial_guess(self, q, grid_m: float = 5e-4) -> np.ndarray:
+        """Surface parameters near the contact for small yaw: the cross-section approach of
+        :mod:`.gap_search` in 3D. Each circle of the wheel (a ``s1w`` of a grid) contributes its
+        lowest point (``s2w`` where the circle's tangent is horizontal), and the one with the
+        smallest gap above the rail (measured along the rail profile's ``z``) is refined on
+        finer grids to about 10 um.
+
+        Raises
+        ------
+        SolverError
+            If no wheel circle lies above the rail (wheelset off the rail).
+        """
+        q = np.asarray(q, float)
+        a = _rotation(q[3:7])
+        s2w = math.atan2(-a[2, 0], a[2, 2])  # lowest point of every circle (no dependence on s1w)
+        lo, hi = self.wheel.s_min, self.wheel.s_max
+        n = max(int(math.ceil((hi - lo) / grid_m)), 8) + 1
+        grid = np.linspace(lo, hi, n)
+        best = None
+        for _ in range(4):
+            gap, s2r = self._vertical_gap(q, a, s2w, grid)
+            if not np.isfinite(gap).any():
+                raise SolverError(f"{self.side} wheel: no point of the wheel lies above the rail at "
+                                  f"q={np.array2string(q, precision=5)} (wheelset off the rail)")
+            j = int(np.nanargmin(gap))
+            best = (grid[j], s2r[j])
+            h = grid[1] - grid[0]
+            grid = np.linspace(max(grid[j] - h, lo), min(grid[j] + h, hi), 9)
+        pw = self.wheel.position(best[0])
+        rho = self._head[1] + pw[1]
+        point = q[:3] + a @ np.array([rho * math.sin(s2w), self.sign * (self._head[2] + pw[0]), -rho * math.cos(s2w)])
+        return np.array([best[0], s2w, point[0], best[1]])
+
+    def _vertical_gap(self, q, a, s2w, s1w):
+        pw = self.wheel.position(s1w)
+        rho = self._head[1] + pw[:, 1]
+        u = np.stack([rho * math.sin(s2w), self.sign * (self._head[2] + pw[:, 0]), -rho * math.cos(s2w)])
+        points = q[:3, None] + a @ u
+        rel = points - np.array([points[0], np.full(len(s1w), self.rail_origin_m[1]),
+                                 np.full(len(s1w), self.rail_origin_m[2])])
+        local = _rot_x(-self._roll) @ rel
+        y_r = self.sign * local[1]
+        s2r = self.rail.s_at(y_r)
+        z_r = np.full(len(s1w), np.nan)
+        ok = np.isfinite(s2r)
+        z_r[ok] = self.rail.position(s2r[ok])[:, 1]
+        return local[2] - z_r, s2r
+
+    def solve(self, q, s_guess=None, *, tol: float = 1e-13, max_iter: int = 40) -> ContactPoint:
+        """Contact point of the wheelset at ``q``: the four surface parameters from the two
+        in-plane coincidence and two tangency conditions, and the normal gap (the fifth).
+
+        Rail-frame form: Newton on rows 1, 2, 4, 5 of eq. 22, the gap is row 3. Global form:
+        Newton on ``C - [g n; 0; 0] = 0`` for ``(s, g)`` (eq. 21 with the gap ``g`` along the
+        rail normal ``n`` taken out), so both forms define the same point. Newton (with
+        backtracking on the residual) starts from ``s_guess`` (e.g. the previous step's
+        solution), else from :meth:`initial_guess` (the lowest point of the vertical-gap search),
+        and, should it fail from ``s_guess``, once more from :meth:`initial_guess`. It returns
+        the stationary point of the gap that Newton reaches: on nearly conformal profiles
+        (EN 15302 wheel A on rail A) secondary local minima of the gap lie within 0.2 um of the
+        lowest one and a few millimetres away, so a guess that far off may land on one of them
+        (the contact jump of a constraint formulation; without ``s_guess`` the lowest is found).
+
+        Raises
+        ------
+        SolverError
+            If Newton does not converge or the point leaves a profile.
+        """
+        q = np.asarray(q, float)
+        if s_guess is not None:
+            try:
+                return self._newton(q, np.array(s_guess, float), tol, max_iter)
+            except SolverError:
+                pass
+        return self._newton(q, self.initial_guess(q), tol, max_iter)
+
+    def _newton(self, q, s, tol, max_iter) -> ContactPoint:
+        lo = np.array([self.wheel.s_min, -math.pi, -np.inf, self.rail.s_min])
+        hi = np.array([self.wheel.s_max, math.pi, np.inf, self.rail.s_max])
+        x = np.r_[s, 0.0]  # surface parameters and (global form) the gap
+        f, jac = self._conditions(q, x)
+        res = float(np.abs(f).max())
+        for it in range(1, max_iter + 1):
+            try:
+                step = -np.linalg.solve(jac, f)
+            except np.linalg.LinAlgError:
+                raise SolverError(f"{self.side} wheel: singular contact Jacobian C_s at s={x[:4]} (the wheel "
+                                  "and rail tangent planes cannot be matched there)") from None
+            if step.size == 4:
+                step = np.r_[step, 0.0]
+            scale = min(1.0, float(np.min(MAX_STEP / np.maximum(np.abs(step[:4]), 1e-300))))
+            # Backtracking on |f|: Newton on the stationarity conditions may overshoot where the
+            # profiles are nearly conformal.
+            alpha = scale
+            for _ in range(12):
+                x_new = np.r_[np.clip(x[:4] + alpha * step[:4], lo, hi), x[4] + alpha * step[4]]
+                f_new, jac_new = self._conditions(q, x_new)
+                res_new = float(np.abs(f_new).max())
+                if res_new <= (1 - 1e-4 * alpha) * res or res_new <= tol:
+                    break
+                alpha *= 0.5
+            x, f, jac, res = x_new, f_new, jac_new, res_new
+            if res <= tol or (alpha == 1.0 and np.abs(step[:4]).max() < 1e-14):
+                break
+        else:
+            raise SolverError(f"{self.side} wheel: contact point not found in {max_iter} Newton iterations "
+                              f"(residual {res:.3g}) at q={np.array2string(q, precision=5)}")
+        s = x[:4]
+        k = self.evaluate(q, s)  # raises ParameterError if the point left a profile
+        if self.form == "railframe":
+            gap, res = float(k.c[2]), float(np.abs(k.c[[0, 1, 3, 4]]).max())
+        else:
+            n = self._normal_from_jacobian(k.C_s)
+            gap = float(n @ k.c[:3])
+            res = float(np.abs(np.r_[k.c[:3] - gap * n, k.c[3:]]).max())
+        if not res < 1e-8:
+            raise SolverError(f"{self.side} wheel: Newton stalled at residual {res:.3g} (s={s})")
+        return self._describe(s, gap, res, it)
+
+    def _conditions(self, q, x):
+        """The four (rail frame) or five (global, with the gap ``x[4]``) conditions and their
+        Jacobian in ``x``."""
+        k = self.evaluate(q, x[:4], clip=True)
+        if self.form == "railframe":
+            return k.c[[0, 1, 3, 4]], k.C_s[[0, 1, 3, 4]]
+        n = self._normal_from_jacobian(k.C_s)
+        jac = np.zeros((5, 5))
+        jac[:, :4] = k.C_s  # the normal's dependence on s2r is left out (exact at zero gap)
+        jac[:3, 4] = -n
+        return k.c - np.r_[x[4] * n, 0.0, 0.0], jac
+
+    def _normal_from_jacobian(self, c_s: np.ndarray) -> np.ndarray:
+        # Rows 1-3 of eq. 21 are r^w - r^r: their s1r and s2r columns are -t1^r and -t2^r.
+        n = self.sign * np.cross(-c_s[:3, 2], -c_s[:3, 3])
+        return n / np.linalg.norm(n)
+
+    def _describe(self, s, gap, res, iterations) -> ContactPoint:
+        pw = self.wheel.position(s[0])
+        pr, dr = self.rail.position(s[3]), self.rail.derivative(s[3])
+        a_rp = _rot_x(self._roll)
+        n_bar = np.array([0.0, -self.sign * dr[1], dr[0]]) / math.hypot(*dr)
+        normal = a_rp @ n_bar
+        in_track = _rot_x(-self.cant_rad) @ normal
+        point = np.array([s[2], *self.rail_origin_m[1:]]) + a_rp @ np.array([0.0, self.sign * pr[0], pr[1]])
+        return ContactPoint(
+            s=np.array(s, float), gap_m=float(gap), rolling_radius_m=float(self._head[1] + pw[1]),
+            contact_angle_rad=float(math.atan2(-self.sign * in_track[1], in_track[2])),
+            wheel_y_m=float(pw[0]), rail_y_m=float(pr[0]), point_m=point, normal=normal, residual=res,
+            iterations=iterations,
+        )
+
+
+def _rotation(theta) -> np.ndarray:
+    """Rotation matrix of Euler parameters (as :func:`symcat.symbolic.rigid.rotation_matrix`)."""
+    e0, e = theta[0], np.asarray(theta[1:4], float)
+    skew = np.array([[0, -e[2], e[1]], [e[2], 0, -e[0]], [-e[1], e[0], 0]])
+    return (2 * e0**2 - 1) * np.eye(3) + 2 * (np.outer(e, e) + e0 * skew)
+
+
+def euler_parameters_roll(phi_rad: float) -> np.ndarray:
+    """Euler parameters of a rotation by ``phi_rad`` about the global ``x`` axis (wheelset roll,
+    positive lifting the left wheel)."""
+    return np.array([math.cos(phi_rad / 2), math.sin(phi_rad / 2), 0.0, 0.0])
