@@ -45,13 +45,13 @@ against Fresnel integrals is round-off, about 1e-12 m over kilometres).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from symcat.errors import ParameterError
 
 from .irregularities import Irregularities, _positive, erri_b176_psd, synthetic_irregularities  # noqa: F401
+from .track_parts import Curve, FramePiece, RailFrame, Tangent, Transition, rail_offset_for  # noqa: F401
 
 #: Lateral distance from the track centre to the UIC60 1:40 profile origin for a 1.435 m gauge
 #: measured 14 mm below the rail top (:func:`rail_offset_for` with the shipped profile) [m].
@@ -63,116 +63,6 @@ _PANEL_HEADING_RAD = 0.25
 _PANEL_LENGTH_M = 25.0
 _KX = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
 _KZ = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
-
-
-@dataclass(frozen=True)
-class Tangent:
-    """Straight track of ``length_m`` [m]."""
-
-    length_m: float
-
-
-@dataclass(frozen=True)
-class Curve:
-    """Circular curve.
-
-    Attributes
-    ----------
-    length_m : float
-        Length along the centreline [m].
-    radius_m : float
-        Radius of the centreline [m], > 0.
-    direction : str
-        ``"left"`` or ``"right"``.
-    cant_m : float
-        Superelevation of the outer rail over the inner one [m] (negative: inner rail high).
-    """
-
-    length_m: float
-    radius_m: float
-    direction: str = "left"
-    cant_m: float = 0.0
-
-
-@dataclass(frozen=True)
-class Transition:
-    """Clothoid of ``length_m`` [m]: curvature and superelevation linear in ``s`` from those at
-    the end of the previous segment to those at the start of the next (a tangent before the
-    first or after the last segment)."""
-
-    length_m: float
-
-
-@dataclass(frozen=True)
-class RailFrame:
-    """A rail profile frame and its derivatives along the track, vectorised over ``n`` points.
-
-    Attributes
-    ----------
-    R, dR_ds, d2R_ds2 : ndarray (n, 3)
-        Origin [m] and its first [-] and second [1/m] derivatives with respect to ``s``.
-    A, dA_ds, d2A_ds2 : ndarray (n, 3, 3)
-        Orientation (columns: tangent, lateral to the left, up) and its derivatives [1/m],
-        [1/m^2].
-    """
-
-    R: np.ndarray
-    dR_ds: np.ndarray
-    d2R_ds2: np.ndarray
-    A: np.ndarray
-    dA_ds: np.ndarray
-    d2A_ds2: np.ndarray
-
-
-@dataclass(frozen=True)
-class FramePiece:
-    """Cubic Hermite approximation of a rail frame on ``[s_start_m, s_end_m]``, exact in value and
-    first derivative at both ends: ``R(s) = sum_k position_coeffs[k] t**k`` with
-    ``t = s - s_start_m`` (ascending powers), the same for ``A`` with ``orientation_coeffs``.
-
-    Attributes
-    ----------
-    s_start_m, s_end_m : float
-        Ends of the piece [m].
-    position_coeffs : ndarray (4, 3)
-    orientation_coeffs : ndarray (4, 3, 3)
-    """
-
-    s_start_m: float
-    s_end_m: float
-    position_coeffs: np.ndarray
-    orientation_coeffs: np.ndarray
-
-    def evaluate(self, s_m, order: int = 0) -> tuple[np.ndarray, np.ndarray]:
-        """``(R, A)`` or their ``order``-th derivative at ``s_m`` (scalar) [m]."""
-        t = float(s_m) - self.s_start_m
-        k = np.arange(order, 4)
-        fac = np.array([math.perm(int(j), order) for j in k], float)
-        w = fac * t ** (k - order)
-        return (np.tensordot(w, self.position_coeffs[order:], 1),
-                np.tensordot(w, self.orientation_coeffs[order:], 1))
-
-
-def rail_offset_for(rail, gauge_m: float = 1.435, gauge_depth_m: float = 0.014,
-                    rail_inclination_rad: float | None = None) -> float:
-    """Lateral distance from the track centre to a rail profile's origin [m], placing its gauge
-    point (``gauge_depth_m`` below the top) at ``gauge_m / 2``: the convention of
-    :func:`.geometry.contact_geometry`.
-
-    Parameters
-    ----------
-    rail : Profile
-        Rail profile (``y`` toward the field side).
-    gauge_m, gauge_depth_m : float
-        Track gauge and its measuring depth [m].
-    rail_inclination_rad : float or None
-        As :class:`TrackLayout`: ``None`` keeps the profile's built-in inclination.
-    """
-    from .geometry import gauge_point
-
-    if rail_inclination_rad is not None:
-        rail = rail.transformed(rail_inclination_rad - rail.inclination_rad)
-    return 0.5 * gauge_m - float(gauge_point(rail, gauge_depth_m)[0])
 
 
 class TrackLayout:
@@ -540,7 +430,3 @@ def _hermite(p0, m0, p1, m1, h):
     c2 = (3.0 * (p1 - p0) - h * (2.0 * m0 + m1)) / h**2
     c3 = (2.0 * (p0 - p1) + h * (m0 + m1)) / h**3
     return np.stack([p0, m0, c2, c3], axis=1)
-
-
-#: ERRI B176 (ORE B176) constants: ``A`` [m rad] for the low and high level, cut-off and
-#: roll-off wavenumbers [rad/m] (as quoted in the vehicle-dynamics literature).
