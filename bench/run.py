@@ -217,6 +217,10 @@ def main():
     from bench.pantograph import section as pantograph_section
 
     pantograph = pantograph_section(REPORT)
+    print("wheelset ...", flush=True)
+    from bench.wheelset import section as wheelset_section
+
+    wheelset = wheelset_section(REPORT)
     lines = [
         "# symcat benchmark report",
         "",
@@ -276,6 +280,8 @@ def main():
         *dynamics,
         "",
         *pantograph,
+        "",
+        *wheelset,
     ]
     (REPORT / "README.md").write_text("\n".join(lines))
     print(f"wrote {REPORT / 'README.md'}")

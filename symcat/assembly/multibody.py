@@ -23,10 +23,9 @@ import numpy as np
 from ..codegen.library import kernel_library, library_interface
 from ..errors import ParameterError
 from ..scene.ancf import AncfBody
-from ..scene.contact import PenaltyContact
-from ..scene.forces import PointLoad, RotationalSpring, SpringDamper
 from ..scene.joints import Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical, perpendiculars, unit
 from ..scene.rigid import RigidBody
+from ..scene.wheelrail import WheelRailJoint
 from ..scene.scene import Scene
 from .sparse import MatrixScatter, to_casadi_sparse, vector_scatter
 from .system import System
@@ -106,6 +105,7 @@ class MultibodyModel:
         self.force_groups: dict[str, KernelGroup] = {}
         self.sliding: list[Sliding] = []
         self.contacts: list[Sliding] = []   # penalty contacts (same window bookkeeping)
+        self.wheelrail: list = []           # wheel/rail contacts (symcat.assembly.wheelrail)
         self.row_names: list[str] = []
         for body in scene.rigid_bodies:
             self._add("normalization_rigid", body.name, [Side("rigid", self._rigid_indices(body.name), body)], {})
@@ -113,8 +113,12 @@ class MultibodyModel:
             self._add_joint(joint)
         for force in scene.force_elements:
             self._add_force(force)
-        self.n_s = len(self.sliding)
-        self.s0 = np.array([sl.joint.s0 for sl in self.sliding])
+        # s = [arc lengths of the sliding joints | 4 surface parameters per wheel/rail contact]
+        self.n_sliding = len(self.sliding)
+        for k, e in enumerate(self.wheelrail):
+            e.s_index = self.n_sliding + 4 * k
+        self.n_s = self.n_sliding + 4 * len(self.wheelrail)
+        self.s0 = np.concatenate([[sl.joint.s0 for sl in self.sliding], *[e.s0 for e in self.wheelrail]])
         self.n_sc = len(self.contacts)
         self.sc0 = np.array([ct.joint.s0 for ct in self.contacts])
         for sl in self.sliding + self.contacts:
@@ -162,6 +166,11 @@ class MultibodyModel:
     def _add_joint(self, joint):
         if isinstance(joint, SlidingJoint):
             self._add_sliding(joint)
+            return
+        if isinstance(joint, WheelRailJoint):
+            from .wheelrail import add_wheelrail
+
+            self.wheelrail.append(add_wheelrail(self, joint))
             return
         if isinstance(joint, Driving):
             side = self.side(joint.body, joint.at if joint.at is not None else self.scene.find(joint.body).position)
@@ -241,46 +250,9 @@ class MultibodyModel:
         return margin
 
     def _add_force(self, force):
-        if isinstance(force, PenaltyContact):
-            from .contact import add_contact
+        from .force_elements import add_force
 
-            self.contacts.append(add_contact(self, force))
-            return
-        if isinstance(force, PointLoad):
-            body = self.scene.find(force.body)
-            side = self.side(force.body, body.position if force.at is None else force.at)
-            values = {f"ui_{k}": side.local["u"][k] for k in range(3)}
-            for key, vec in (("F0", force.force), ("F1", force.force_amplitude), ("T0", force.torque), ("T1", force.torque_amplitude)):
-                values.update({f"{key}_{k}": float(vec[k]) for k in range(3)})
-            values.update(omega=2 * np.pi * force.frequency, phase=force.phase)
-            self._add("pointload_rigid", force.name, [side], values, self.force_groups)
-            return
-        if isinstance(force, SpringDamper):
-            a, b = self.side(force.body_i, force.at_i), self.side(force.body_j, force.at_j)
-            order = {"node": 0, "rigid": 1, "ground": 2}  # libraries exist in this order of kinds
-            if order[a.kind] > order[b.kind]:
-                a, b = b, a
-            library = f"springdamper_{a.kind}_{b.kind}"
-            if a.kind == "ground":
-                raise ParameterError(f"spring-damper {force.name!r}: both ends on the ground")
-            length0 = float(np.linalg.norm(np.asarray(force.at_j, float) - np.asarray(force.at_i, float)))
-            values = {f"ui_{k}": a.local["u"][k] for k in range(3)}
-            values.update({f"uj_{k}": b.local["u"][k] for k in range(3)})
-            values.update(l0=length0 if force.free_length is None else force.free_length, k=force.stiffness,
-                          k3=force.cubic_stiffness, c=force.damping, tension_only=float(force.tension_only))
-            self._add(library, force.name, [a, b], values, self.force_groups)
-            return
-        if isinstance(force, RotationalSpring):
-            a = self.side(force.body_i, self.scene.find(force.body_i).position)
-            b = self.side(force.body_j, a.body.position)
-            x, _ = perpendiculars(force.axis)
-            values = {}
-            self._vectors(values, a, "i", z=unit(force.axis), x=x)
-            self._vectors(values, b, "j", x=x)
-            values.update(phi0=force.angle0, k=force.stiffness, c=force.damping)
-            self._add(f"rotspring_{a.kind}_{b.kind}", force.name, [a, b], values, self.force_groups)
-            return
-        raise ParameterError(f"unsupported force element {type(force).__name__}")
+        add_force(self, force)
 
     def _group_rows(self):
         """Constraint row numbering: groups in order, then sliding joints (3 rows each)."""
@@ -296,9 +268,17 @@ class MultibodyModel:
         for sl in self.sliding:
             self.row_names += [f"{sl.joint.name}[{k}]" for k in range(3)]
             n += 3
+        # Rows that define s in the embedded form, in the order of s: the first (tangency) row
+        # of each sliding joint, four rows of each wheel/rail contact.
+        self.tangency_rows = [self.sliding_row_start + 3 * k for k in range(self.n_sliding)]
+        from .wheelrail import TANGENCY_ROWS
+
+        for e in self.wheelrail:
+            e.row_start = n
+            self.row_names += [f"{e.joint.name}[{k}]" for k in range(5)]
+            self.tangency_rows += [n + r for r in TANGENCY_ROWS]
+            n += 5
         self.n_c = n
-        # Tangency rows (the first row of each sliding joint) are eliminated in the embedded form.
-        self.tangency_rows = [self.sliding_row_start + 3 * k for k in range(self.n_s)]
 
     def coordinate_names(self) -> list[str]:
         names = self.ancf.dofs.names()
@@ -405,6 +385,11 @@ class MultibodyModel:
             cs_parts.append(cs)
             ct_parts.append(c_t)
             qd_parts.append(kl[f"{sl.library}_gamma"](y, y_dot, t, p))
+        if self.wheelrail:
+            from .wheelrail import constraint_parts
+
+            for c, cq, cs, ct, qd in constraint_parts(self, q, v, s, s_dot, t, _place):
+                c_parts.append(c), cq_parts.append(cq), cs_parts.append(cs), ct_parts.append(ct), qd_parts.append(qd)
         if not c_parts:
             z = ca.MX(0, 1)
             return {"c": z, "c_q": ca.MX(0, self.n_q), "c_s": ca.MX(0, self.n_s), "c_t": z, "q_d": z}

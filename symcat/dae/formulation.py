@@ -37,6 +37,7 @@ import scipy.sparse as sps
 from ..assembly.contact import contact_terms
 from ..assembly.multibody import MultibodyModel
 from ..assembly.sparse import to_casadi_sparse
+from ..assembly.wheelrail import GAP_ROW, creep_terms, has_creep
 from ..errors import ParameterError
 
 FORMULATIONS = ("augmented", "embedded")
@@ -93,6 +94,11 @@ class Formulation:
         self.q_fixed = ca.DM(q_fixed)
         self.n_s, self.n_c = model.n_s, model.n_c
         self.n_sc = model.n_sc
+        if formulation == "embedded" and any(e.joint.form == "global" for e in model.wheelrail):
+            names = ", ".join(e.joint.name for e in model.wheelrail if e.joint.form == "global")
+            raise ParameterError(f"formulation='embedded' needs the rail-frame form (eq. 22) of the wheel/rail "
+                                 f"contacts ({names} use form='global'): its rows split into the four that fix "
+                                 f"the surface parameters and the normal gap")
         tang = model.tangency_rows
         self.rows_t = tang
         self.rows_r = [r for r in range(self.n_c) if r not in set(tang)]
@@ -146,15 +152,50 @@ class Formulation:
         """``s_dot`` from the tangency rows, then ``H``, ``Q_cn`` and the reduced constraint terms."""
         probe = self.terms(q_f, v_f, s, ca.MX.zeros(self.n_s), t, sc)
         tr, rr = self.rows_t, self.rows_r
-        c_ts = ca.diag(probe["Cs"][tr, :])           # one s per tangency row
-        s_dot = -ca.mtimes(probe["Cq"][tr, :], v_f) / c_ts
-        k = self.terms(q_f, v_f, s, s_dot, t, sc)
-        c_rs = k["Cs"][rr, :]
-        inv = 1 / ca.diag(k["Cs"][tr, :])
-        h = k["Cq"][rr, :] - ca.mtimes(c_rs, ca.mtimes(ca.diag(inv), k["Cq"][tr, :]))
-        q_cn = k["Qd"][rr] - ca.mtimes(c_rs, inv * k["Qd"][tr])
+        if self.model.wheelrail:
+            # 4x4 blocks per wheel/rail contact (1x1 per sliding joint): a sparse solve.
+            s_dot = -ca.solve(probe["Cs"][tr, :], ca.mtimes(probe["Cq"][tr, :], v_f))
+            k = self.terms(q_f, v_f, s, s_dot, t, sc)
+            c_rs = k["Cs"][rr, :]
+            both = ca.solve(k["Cs"][tr, :], ca.horzcat(k["Cq"][tr, :], k["Qd"][tr]))
+            h = k["Cq"][rr, :] - ca.mtimes(c_rs, both[:, :-1])
+            q_cn = k["Qd"][rr] - ca.mtimes(c_rs, both[:, -1])
+        else:
+            c_ts = ca.diag(probe["Cs"][tr, :])           # one s per tangency row
+            s_dot = -ca.mtimes(probe["Cq"][tr, :], v_f) / c_ts
+            k = self.terms(q_f, v_f, s, s_dot, t, sc)
+            c_rs = k["Cs"][rr, :]
+            inv = 1 / ca.diag(k["Cs"][tr, :])
+            h = k["Cq"][rr, :] - ca.mtimes(c_rs, ca.mtimes(ca.diag(inv), k["Cq"][tr, :]))
+            q_cn = k["Qd"][rr] - ca.mtimes(c_rs, inv * k["Qd"][tr])
         c_dot_r = ca.mtimes(h, v_f) + k["Ct"][rr]
         return {**k, "H": h, "Qcn": q_cn, "s_dot": s_dot, "CR": k["C"][rr], "CT": k["C"][tr], "CRdot": c_dot_r}
+
+    def normal_force_index(self) -> list[int]:
+        """Positions, in this form's multiplier vector, of the gap row of every wheel/rail
+        contact (its normal force is minus that multiplier)."""
+        rows = [e.row_start + GAP_ROW for e in self.model.wheelrail]
+        if self.formulation == "augmented":
+            return rows
+        return [self.rows_r.index(r) for r in rows]
+
+    def creep_force(self, k: dict, s, s_dot, lam):
+        """Generalized creep forces in free coordinates and the creep record (see
+        :func:`symcat.assembly.wheelrail.creep_terms`) for multipliers ``lam`` of this form."""
+        normal = -lam[self.normal_force_index()] if self.model.wheelrail else ca.MX(0, 1)
+        q_c, record = creep_terms(self.model, k["q"], k["v"], s, s_dot, normal)
+        return ca.mtimes(self.P.T, q_c), record
+
+    def creep_function(self) -> ca.Function:
+        """``(q, v, s, s_dot, N) -> (Q_creep, record)`` in free coordinates (numeric use)."""
+        if getattr(self, "_creep_fn", None) is not None:
+            return self._creep_fn
+        m = self.model
+        q, v = ca.MX.sym("q", self.n_f), ca.MX.sym("v", self.n_f)
+        s, w, normal = ca.MX.sym("s", self.n_s), ca.MX.sym("w", self.n_s), ca.MX.sym("N", len(m.wheelrail))
+        q_c, record = creep_terms(m, self.q_fixed + ca.mtimes(self.P, q), ca.mtimes(self.P, v), s, w, normal)
+        self._creep_fn = ca.Function("creep", [q, v, s, w, normal], [ca.mtimes(self.P.T, q_c), record])
+        return self._creep_fn
 
     # --- the DAE ------------------------------------------------------------------------------
     def blocks(self):
@@ -186,6 +227,8 @@ class Formulation:
             w = X["w"] if self.index == "1" else Z["w"]
             k = self.terms(X["q"], X["v"], X["s"], w, t, sc)
             dyn = ca.mtimes(k["M"], Z["a"]) + ca.mtimes(k["Cq"].T, Z["lambda"]) - k["Q"]
+            if has_creep(self.model):
+                dyn -= self.creep_force(k, X["s"], w, Z["lambda"])[0]
             free_s = ca.mtimes(k["Cs"].T, Z["lambda"])
             c_dot = ca.mtimes(k["Cq"], X["v"]) + ca.mtimes(k["Cs"], w) + k["Ct"]
             if self.index == "1":
@@ -198,6 +241,8 @@ class Formulation:
         else:
             k = self.embedded_terms(X["q"], X["v"], Z["s"], t, sc)
             dyn = ca.mtimes(k["M"], Z["a"]) + ca.mtimes(k["H"].T, Z["lambda"]) - k["Q"]
+            if has_creep(self.model):
+                dyn -= self.creep_force(k, Z["s"], k["s_dot"], Z["lambda"])[0]
             if self.index == "1":
                 acc = ca.mtimes(k["H"], Z["a"]) + k["Qcn"] + 2 * al * k["CRdot"] + be**2 * k["CR"]
                 ode = ca.vertcat(X["v"], Z["a"])
@@ -217,6 +262,7 @@ class Formulation:
         coords = [self.model.coordinate_names()[i] for i in self.model.free]
         rows = self.model.row_names
         sliding = [sl.joint.name for sl in self.model.sliding]
+        sliding += [f"{e.joint.name}.{p}" for e in self.model.wheelrail for p in ("s1w", "s2w", "s1r", "s2r")]
         dyn = [f"dynamics of {c}" for c in coords]
         if self.formulation == "augmented":
             names = dyn + [f"C_s^T lambda of {n}" for n in sliding]

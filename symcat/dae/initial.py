@@ -41,8 +41,10 @@ def locate_contacts(fn: ca.Function, q, v, s, w, t, sc, tol: float = 1e-12, max_
     raise SolverError(f"the contact points could not be located on their wires (tangency residual {np.abs(res).max():.3g} m)")
 
 
-def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max_iterations: int = 30):
-    """Consistent ``(x0, z0)`` for ``form`` at time ``t0`` from the scene's initial state.
+def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max_iterations: int = 30,
+                     start: dict | None = None):
+    """Consistent ``(x0, z0)`` for ``form`` at time ``t0`` from the scene's initial state, or from
+    ``start = {"q", "v", "s", "w", "sc"}`` (internal free coordinates; e.g. after a contact jump).
 
     Raises
     ------
@@ -55,9 +57,11 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     v = form.to_internal(model.v0[model.free].copy())
     s = model.s0.copy()
     w = np.zeros(form.n_s)
+    sc = model.sc0.copy()
+    if start is not None:
+        q, v, s, w, sc = (np.array(start[k], float) for k in ("q", "v", "s", "w", "sc"))
     names = model.row_names
     n_f = form.n_f
-    sc = model.sc0.copy()
 
     def evaluate(q, v, s, w):
         out = fn(q, v, s, w, t0, sc)
@@ -95,21 +99,26 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     xb, zb = form.blocks()
     x0 = np.zeros(sum(b.size for b in xb.values()))
     z0 = np.zeros(sum(b.size for b in zb.values()))
+    creep = CreepCoupling(form, q, v, s, w)
     if form.formulation == "augmented":
-        a, s_dd, lam = kkt_solve(m, f, cq, cs, qd)
+        a, s_dd, lam = creep.solve(lambda force: kkt_solve(m, force, cq, cs, qd), f)
         values_x = {"q": q, "s": s, "v": v, "w": w}
         values_z = {"a": a, "s_dd": s_dd, "w": w, "lambda": lam, "mu": np.zeros(form.n_c), "sc": sc}
     else:
         tr, rr = form.rows_t, form.rows_r
         cq_d = cq.toarray() if form.n_s else cq
         if form.n_s:
-            inv = 1 / np.array([cs[r, k] for k, r in enumerate(tr)])
-            h = sps.csc_matrix(cq_d[rr] - cs[rr] @ (inv[:, None] * cq_d[tr]))
-            q_cn = qd[rr] - cs[rr] @ (inv * qd[tr])
+            both = np.linalg.solve(cs[tr], np.c_[cq_d[tr], qd[tr]])
+            h = sps.csc_matrix(cq_d[rr] - cs[rr] @ both[:, :-1])
+            q_cn = qd[rr] - cs[rr] @ both[:, -1]
         else:
             h, q_cn = cq, qd
         kkt = sps.bmat([[m, h.T], [h, None]], format="csc")
-        sol = _solve(kkt, np.r_[f, -q_cn])
+        def embedded(force):
+            sol = _solve(kkt, np.r_[force, -q_cn])
+            return sol, sol[n_f:]
+
+        sol = creep.solve(embedded, f)[0]
         values_x = {"q": q, "v": v}
         values_z = {"a": sol[:n_f], "s": s, "lambda": sol[n_f:], "mu": np.zeros(len(rr)), "sc": sc}
     for name, b in xb.items():
@@ -117,6 +126,36 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     for name, b in zb.items():
         z0[b.slice] = values_z[name]
     return x0, z0
+
+
+class CreepCoupling:
+    """Creep forces depend on the normal forces, which are multipliers: a fixed-point iteration
+    over the linear solve ``solve(force) -> (..., multipliers)`` (creep forces are small against
+    the normal forces and, for the linear law, independent of them: two or three passes)."""
+
+    def __init__(self, form: Formulation, q, v, s, w, index=None):
+        from ..assembly.wheelrail import has_creep
+
+        self.active = has_creep(form.model)
+        if self.active:
+            # Where the normal forces sit in the multipliers (default: the form's own layout).
+            self.index = form.normal_force_index() if index is None else index
+            fn = form.creep_function()
+            self.force = lambda normal: np.asarray(fn(q, v, s, w, normal)[0]).ravel()
+
+    def solve(self, solve, f, tol: float = 1e-10, max_iterations: int = 50):
+        out = solve(f)
+        if not self.active:
+            return out
+        normal = -np.asarray(out[-1])[self.index]
+        for _ in range(max_iterations):
+            out = solve(f + self.force(normal))
+            new = -np.asarray(out[-1])[self.index]
+            if np.abs(new - normal).max(initial=0.0) <= tol * (1.0 + np.abs(new).max(initial=0.0)):
+                return out
+            normal = new
+        raise SolverError(f"creep forces and normal forces did not settle in {max_iterations} passes "
+                          f"(normal forces {np.array2string(new, precision=4)} N)")
 
 
 def kkt_solve(m, f, cq, cs, qd):

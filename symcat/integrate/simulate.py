@@ -18,9 +18,11 @@ import scipy.sparse.linalg as spla
 from ..assembly.multibody import MultibodyModel
 from ..dae.formulation import Formulation
 from ..assembly.sparse import to_scipy
-from ..dae.initial import consistent_state, kkt_solve
+from ..dae.initial import CreepCoupling, consistent_state, kkt_solve
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
+from .contact_jumps import jump_contacts
+from .failure import failure
 
 STAT_KEYS = ("nsteps", "nfevals", "nlinsetups", "netfails", "nniters", "nncfails")
 
@@ -55,6 +57,10 @@ class SimulationResult:
     contacts : dict
         Penalty contact name -> ``{"s_m", "gap_m", "force_N"}`` histories (n_t,): arc length,
         normal gap (> 0 separated) and normal force.
+    wheelrail : dict
+        Wheel/rail contact name -> histories: ``normal_force_N`` (n_t,), the surface parameters
+        ``s`` (n_t, 4: s1w m, s2w rad, s1r m, s2r m), ``xi_x``, ``xi_y`` (-), ``phi_per_m``
+        (spin, 1/m) and the creep forces ``fx_N``, ``fy_N``, ``mz_Nm`` (zero without creep).
     """
 
     t_s: np.ndarray
@@ -72,6 +78,7 @@ class SimulationResult:
     stats: dict = field(default_factory=dict)
     a: np.ndarray | None = None
     contacts: dict = field(default_factory=dict)
+    wheelrail: dict = field(default_factory=dict)
 
     def coordinate(self, name: str) -> np.ndarray:
         """History of one coordinate, e.g. ``"wire[3].z"`` or ``"body.x"``."""
@@ -85,6 +92,7 @@ class SimulationResult:
                   **{f"energy_{k}_J": v for k, v in self.energy_J.items()},
                   **{f"reaction_{k}_N": v for k, v in self.reactions_N.items()},
                   **{f"contact_{k}_{n}": v for k, c in self.contacts.items() for n, v in c.items()},
+                  **{f"wheelrail_{k}_{n}": v for k, c in self.wheelrail.items() for n, v in c.items()},
                   **({"a": self.a} if self.a is not None else {}),
                   "coordinate_names": np.array(self.coordinate_names), "row_names": np.array(self.row_names)}
         np.savez_compressed(path, **arrays)
@@ -146,7 +154,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     # Algebraic variables (accelerations, multipliers) are out of the error test, but their
     # absolute tolerance still weighs IDAS's Newton convergence test: with the differential
     # atol, GGL's mu (identically ~0) can never "converge" and IDAS reports IDA_CONV_FAIL.
-    n_x, n_z = len(x), len(z)
+    n_z = len(z)
     opts = {"reltol": rtol, "abstolv": _atol_vector(form, atol) + [algebraic_atol] * n_z, "suppress_algebraic": True,
             "calc_ic": False, "max_num_steps": int(max_steps), "linear_solver": linear_solver}
     if max_step:
@@ -176,12 +184,18 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             try:
                 out = integ(x0=x, z0=z, p=t_grid[a])
             except RuntimeError as exc:
+                if model.wheelrail:
+                    # A wheel/rail contact point may have had to jump (see contact_jumps).
+                    x, z, jumped = jump_contacts(form, x, z, t_grid[a])
+                    if jumped:
+                        stats["contact_jumps"] = stats.get("contact_jumps", 0) + len(jumped)
+                        continue
                 if b - a > 1 and model.windowed():
                     # Possibly a sliding point left its window: retry shorter before giving up.
                     stats["retries"] = stats.get("retries", 0) + 1
                     limit = max(1, (b - a) // 2)
                     continue
-                raise _failure(form, exc, t_grid[a], x, z, dae_fn, t_grid[a + 1] - t_grid[a]) from None
+                raise failure(form, exc, t_grid[a], x, z, dae_fn, t_grid[a + 1] - t_grid[a]) from None
             st = integ.stats()
             for k in STAT_KEYS:
                 stats[k] += int(st.get(k, 0))
@@ -197,6 +211,10 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
                 xs.append(xf[:, j])
                 zs.append(zf[:, j])
             x, z = xf[:, -1], zf[:, -1]
+            x, z, jumped = jump_contacts(form, x, z, t_grid[b])
+            if jumped:
+                stats["contact_jumps"] = stats.get("contact_jumps", 0) + len(jumped)
+                xs[-1], zs[-1] = x, z
             done = b
             bar.update(t_grid[b])
             a = b
@@ -233,6 +251,8 @@ def _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges) -> int:
         return int(fixed_edges[np.searchsorted(fixed_edges, a, side="right")])
     dt = t_grid[1] - t_grid[0]
     span = max(1, int(round(0.1 * n_out)))
+    if model.wheelrail:
+        span = 1  # contact jumps are looked for between calls
     if model.windowed():
         s_dot = np.abs(_s_dot(form, x, z))
         for sl, v in zip(model.windowed(), s_dot):
@@ -263,14 +283,15 @@ def _s_dot(form, x, z) -> np.ndarray:
     parts = _split(form, x, z)
     # Algebraic arc lengths (embedded form, contacts): the largest velocity bounds s_dot well enough here.
     bound = np.abs(parts["v"]).max(initial=0.0)
-    sliding = parts["w"] if "w" in parts else np.full(form.n_s, bound)
+    n = form.model.n_sliding  # wheel/rail surface parameters have no window
+    sliding = parts["w"][:n] if "w" in parts else np.full(n, bound)
     return np.r_[sliding, np.full(form.n_sc, bound)]
 
 
 def _window_s(form, x, z) -> np.ndarray:
     """Arc lengths of the sliding joints, then of the contacts."""
     parts = _split(form, x, z)
-    return np.r_[parts["s"], parts.get("sc", np.zeros(0))]
+    return np.r_[parts["s"][: form.model.n_sliding], parts.get("sc", np.zeros(0))]
 
 
 def _update_windows(model, form, x, z) -> bool:
@@ -290,42 +311,6 @@ def _split(form, x, z) -> dict:
     out = {k: np.asarray(x)[b.slice] for k, b in xb.items()}
     out.update({k: np.asarray(z)[b.slice] for k, b in zb.items() if k not in out})
     return out
-
-
-def _failure(form, exc, t, x, z, dae_fn, dt) -> SolverError:
-    """Explain an IDAS failure: time, IDAS's reason, the largest algebraic residual (by name) of
-    the last accepted state pushed one output step ahead along its derivative, and constraint
-    rows that have become nearly dependent."""
-    reason = str(exc).strip().splitlines()[-1] if str(exc).strip() else repr(exc)
-    nil = ca.DM(0, 1)
-    x_dot = np.asarray(dae_fn(0.0, x, z, t, nil)[0]).ravel()
-    res = np.abs(np.asarray(dae_fn(dt, x + dt * x_dot, z, t, nil)[1]).ravel())
-    names = form.residual_names()
-    worst = names[int(np.argmax(res))] if res.size else "none"
-    message = (f"IDAS failed in the step after t = {t:.6g} s: {reason}. Largest algebraic residual one "
-               f"output step ahead: {worst} ({res.max(initial=0):.3g}).")
-    message += _dependent_rows(form, x, z, t)
-    message += (" Try a smaller rtol or max_step, the other formulation or index, or look for a joint or "
-                "force that becomes singular; the results so far are in .partial")
-    return SolverError(message)
-
-
-def _dependent_rows(form, x, z, t) -> str:
-    model = form.model
-    if not 0 < model.n_c <= 2000:
-        return ""
-    parts = _split(form, x, z)
-    n_s = form.n_s
-    qs, vs, ss, ws = ca.MX.sym("q", form.n_f), ca.MX.sym("v", form.n_f), ca.MX.sym("s", n_s), ca.MX.sym("w", n_s)
-    k = form.terms(qs, vs, ss, ws, ca.MX(t), ca.MX.sym("sc", form.n_sc))
-    jac = ca.Function("j", [qs, vs, ss, ws], [ca.horzcat(k["Cq"], k["Cs"])])
-    j = np.asarray(ca.densify(jac(parts["q"], parts["v"], parts["s"], parts.get("w", np.zeros(n_s)))))
-    u, sv, _ = np.linalg.svd(j, full_matrices=False)
-    if sv.size == 0 or sv[-1] > 1e-6 * sv[0]:
-        return ""
-    weights = np.abs(u[:, -1])
-    rows = [model.row_names[r] for r in np.argsort(weights)[::-1][:3] if weights[r] > 0.1]
-    return f" The constraints are nearly dependent (a locked or singular mechanism?): {', '.join(rows)}."
 
 
 def _result(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
@@ -372,6 +357,9 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
     acc = np.zeros_like(q)
     lam = np.zeros((len(parts), model.n_c))
     s_dot = np.zeros((len(parts), n_s))
+    normal_rows = [e.row_start + 2 for e in model.wheelrail]  # the gap rows (lam: augmented layout)
+    creep_record = np.zeros((len(parts), 6 * len(model.wheelrail)))
+    creep_fn = form.creep_function() if model.wheelrail else None
     pos, vel, kin, pot = (np.zeros(len(parts)) for _ in range(4))
     reactions = {name.split("[")[0]: np.zeros((len(parts), 3)) for name in model.row_names}
     for i, (p, ti) in enumerate(zip(parts, t)):
@@ -384,8 +372,11 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
         # Multipliers from the KKT system at each output (exact for the state, whatever IDAS's
         # tolerance on algebraic variables): the same for every formulation.
         if model.n_c:
-            a_i, _, lam[i] = kkt_solve(to_scipy(mass), np.asarray(force).ravel(), to_scipy(cq),
-                                       np.asarray(ca.densify(cs)), np.asarray(qd).ravel())
+            creep = CreepCoupling(form, p["q"], p["v"], p["s"], s_dot[i], normal_rows)
+            mass_i, cq_i, cs_i, qd_i = to_scipy(mass), to_scipy(cq), np.asarray(ca.densify(cs)), np.asarray(qd).ravel()
+            a_i, _, lam[i] = creep.solve(lambda f: kkt_solve(mass_i, f, cq_i, cs_i, qd_i), np.asarray(force).ravel())
+            if creep.active:
+                creep_record[i] = np.asarray(creep_fn(p["q"], p["v"], p["s"], s_dot[i], -lam[i][normal_rows])[1]).ravel()
         else:
             a_i = spla.spsolve(to_scipy(mass).tocsc(), np.asarray(force).ravel()) if n_f else np.zeros(0)
         acc[i, model.free] = form.to_physical(np.atleast_1d(a_i))
@@ -401,7 +392,20 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
         stats=stats, a=acc,
         contacts={ct.joint.name: {"s_m": sc[:, k], "gap_m": gaps[:, k], "force_N": contact_forces[:, k]}
                   for k, ct in enumerate(model.contacts)},
+        wheelrail={e.joint.name: {"normal_force_N": _normal_force(e, lam), "s": s[:, e.s_index : e.s_index + 4],
+                                  **{name: creep_record[:, 6 * k + j] for j, name in
+                                     enumerate(("xi_x", "xi_y", "phi_per_m", "fx_N", "fy_N", "mz_Nm"))}}
+                   for k, e in enumerate(model.wheelrail)},
     )
+
+
+def _normal_force(entry, lam) -> np.ndarray:
+    """Normal force (N) of a wheel/rail contact from the multipliers: minus that of the gap row
+    (eq. 22), or, for eq. 21 (frictionless), the magnitude of the three distance rows' force."""
+    rows = lam[:, entry.row_start : entry.row_start + 3]
+    if entry.joint.form == "railframe":
+        return -rows[:, 2]
+    return -np.sign(rows[:, 2]) * np.linalg.norm(rows, axis=1)
 
 
 def _reactions(model, form, cq_free, lam, reactions, i):

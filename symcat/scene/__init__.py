@@ -7,8 +7,9 @@ from .loads import NodalForce, SlopeMoment
 from .rigid import RigidBody
 from .scene import Scene
 from .sections import Material, Section
+from .wheelrail import CreepModel, WheelRailJoint
 
 __all__ = [
-    "GROUND", "AncfBody", "Driving", "Fixed", "Material", "NodalForce", "PenaltyContact", "PointLoad", "Prismatic", "Revolute",
-    "RigidBody", "RotationalSpring", "Scene", "Section", "SlidingJoint", "SlopeMoment", "Spherical", "SpringDamper",
+    "GROUND", "AncfBody", "CreepModel", "Driving", "Fixed", "Material", "NodalForce", "PenaltyContact", "PointLoad", "Prismatic", "Revolute",
+    "RigidBody", "RotationalSpring", "Scene", "Section", "SlidingJoint", "SlopeMoment", "Spherical", "SpringDamper", "WheelRailJoint",
 ]

@@ -13,8 +13,9 @@ from .forces import PointLoad, RotationalSpring, SpringDamper
 from .joints import Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical
 from .loads import NodalForce, SlopeMoment
 from .rigid import RigidBody
+from .wheelrail import WheelRailJoint
 
-JOINT_TYPES = (Spherical, Revolute, Prismatic, Fixed, Driving, SlidingJoint)
+JOINT_TYPES = (Spherical, Revolute, Prismatic, Fixed, Driving, SlidingJoint, WheelRailJoint)
 FORCE_TYPES = (SpringDamper, RotationalSpring, PointLoad, PenaltyContact)
 
 
@@ -102,6 +103,6 @@ class Scene:
 def _body_refs(item) -> list:
     if isinstance(item, (SlidingJoint, PenaltyContact)):
         return [item.body]
-    if isinstance(item, (Driving, PointLoad)):
+    if isinstance(item, (Driving, PointLoad, WheelRailJoint)):
         return [item.body]
     return [item.body_i, item.body_j]

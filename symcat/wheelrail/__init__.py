@@ -11,6 +11,7 @@ equivalent conicity (EN 15302). NumPy/SciPy only.
 """
 from .conicity import equivalent_conicity
 from .geometry import ContactGeometry, TrackCrossSection, WheelsetDimensions, contact_geometry, gauge_point
+from .placement import WheelsetPlacement, wheelset_on_track
 from .profiles import Profile, validate_points
 from .standard_profiles import (
     PAIR_NAMES,
@@ -48,4 +49,6 @@ __all__ = [
     "s1002",
     "uic60_canted",
     "validate_points",
+    "WheelsetPlacement",
+    "wheelset_on_track",
 ]

@@ -210,6 +210,14 @@ class WheelRailContact:
         y = np.r_[np.asarray(q, float), np.asarray(s, float)]
         return _np(self.kernels[f"{self.library}_c"](y, t, self.parameters(s, **kw))).ravel()
 
+    def gap(self, q, s) -> float:
+        """Normal gap (m) at surface parameters ``s`` as they are (no solve): the gap row of
+        eq. 22, or the rail-normal component of eq. 21's distance rows."""
+        k = self.evaluate(q, s, clip=True)
+        if self.form == "railframe":
+            return float(k.c[2])
+        return float(self._normal_from_jacobian(k.C_s) @ k.c[:3])
+
     def evaluate(self, q, s, q_dot=None, s_dot=None, t: float = 0.0, **kw) -> ContactKernels:
         """``C``, ``C_q``, ``C_s``, ``C_t`` and (with velocities) ``Q_d`` at one state."""
         q, s = np.asarray(q, float), np.asarray(s, float)

@@ -1,0 +1,58 @@
+"""Wheelset on straight track (constraint wheel/rail contact): work-precision and wall time per
+simulated second. ``python -m bench.wheelset`` prints the section; ``make bench`` adds it to the
+report."""
+from __future__ import annotations
+
+import statistics
+import sys
+
+import numpy as np
+
+from symcat.model import load_model
+
+T_END = 4.0
+
+
+def _run(params):
+    model = load_model("wheelset")
+    resolved = model.resolve(params)
+    resolved["progress"] = False  # not a model parameter: the bench prints no progress bars
+    return model.run(resolved)
+
+
+def work_precision(profile="conical", speed=10.0, creep="linear"):
+    """Lateral displacement error (max over the run) against rtol 1e-10, both formulations."""
+    base = {"profile": profile, "speed_ms": speed, "creep": creep, "t_end": T_END, "n_out": 200}
+    ref = _run({**base, "rtol": 1e-10}).arrays["result"].coordinate("wheelset.y")
+    rows = []
+    for form in ("augmented", "embedded"):
+        for rtol in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8):
+            walls, out = [], None
+            for _ in range(3):
+                out = _run({**base, "rtol": rtol, "formulation": form})
+                walls.append(out.summary["wall_s"])
+            res = out.arrays["result"]
+            err = float(np.abs(res.coordinate("wheelset.y") - ref).max())
+            rows.append((profile, form, rtol, err, statistics.median(walls) / T_END, res.stats["nsteps"],
+                         res.stats.get("contact_jumps", 0), float(res.position_drift.max())))
+    return rows
+
+
+def section(report_dir=None) -> list[str]:
+    rows = work_precision() + work_precision("s1002_uic60")
+    return [
+        "## Wheelset with constraint wheel/rail contact (`wheelset`)",
+        "",
+        f"10 m/s, linear creep, 3 mm initial offset, {T_END:g} s. Error: largest difference of the "
+        "lateral displacement from the same model at rtol 1e-10. Wall time per simulated second is the "
+        "median of 3 runs (including the post-processing of 200 outputs).",
+        "",
+        "| profiles | formulation | rtol | error [m] | wall per simulated s | steps | contact jumps | max drift [m] |",
+        "|---|---|---:|---:|---:|---:|---:|---:|",
+        *[f"| {p} | {f} | {r:g} | {e:.2e} | {w:.3f} | {s} | {j} | {d:.1e} |" for p, f, r, e, w, s, j, d in rows],
+    ]
+
+
+if __name__ == "__main__":
+    print("\n".join(section()))
+    sys.exit(0)

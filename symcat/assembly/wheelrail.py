@@ -1,0 +1,268 @@
+"""Assembly of wheel/rail constraint contacts (:class:`symcat.scene.WheelRailJoint`).
+
+Each contact owns four consecutive entries of the surface-parameter vector ``s`` (after the
+sliding joints' arc lengths) and five constraint rows (after the sliding joints' rows). The
+compiled kernel (:mod:`symcat.symbolic.wheelrail`) is exact on one cubic piece of each profile;
+the piece is selected *inside the CasADi graph* by a compiled SX lookup ``s -> (s0, coefficients)``
+made of comparisons, whose derivative is zero, so ``C``, ``C_q``, ``C_s`` and ``Q_d`` follow the
+surface parameters across piece ends (C2 splines: the values are continuous there).
+
+Creep forces (:class:`symcat.scene.CreepModel`) are applied forces at the wheel's material point
+at the contact; they depend on the normal force, which is the multiplier of the gap row
+(``N = -lambda``: the constraint force on the wheelset is ``-C_q^T lambda`` and the gap row's
+gradient is the rail's outward normal), so :mod:`symcat.dae.formulation` adds them to the
+dynamics with the multipliers. The contact frame is ``t1 = x`` (rolling direction, tangent
+track), ``n`` the rail's outward normal at the contact, ``t2 = n x t1``; the creepages are the
+material point's velocity along ``t1, t2`` and the wheelset's angular velocity along ``n``,
+divided by ``V = sqrt((R_dot . t1)^2 + v_ref^2)``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from ..codegen.library import kernel_library
+from ..errors import ParameterError, SolverError
+from ..scene.rigid import RigidBody
+from ..scene.wheelrail import WheelRailJoint
+from ..wheelrail.creep import SHEAR_MODULUS_STEEL_PA, kalker_coefficients, kalker_linear_forces
+from ..wheelrail.hertz import hertz_contact, relative_curvatures
+
+#: Rows of a contact that define its surface parameters in the embedded form (eq. 22: the two
+#: in-plane coincidence rows and the two tangency rows); row 2 is the normal gap.
+TANGENCY_ROWS = (0, 1, 3, 4)
+GAP_ROW = 2
+#: A wheelset farther than this from touching its rail at the start is "off the rails" (m).
+PLACEMENT_TOLERANCE_M = 2e-3
+
+
+@dataclass
+class CreepSetup:
+    """Contact ellipse and Kalker coefficients at the nominal load (see :class:`CreepModel`)."""
+
+    a_m: float
+    b_m: float
+    c11: float
+    c22: float
+    c23: float
+    c33: float
+    nominal_normal_force_N: float
+
+
+@dataclass
+class WheelRailEntry:
+    joint: WheelRailJoint
+    contact: object                 # symcat.wheelrail.WheelRailContact
+    library: str
+    body: RigidBody
+    rows: list                      # the wheelset's 7 global coordinate indices
+    s0: np.ndarray                  # initial surface parameters
+    head: np.ndarray                # the 6 constant kernel parameters
+    wheel_piece: ca.Function
+    rail_piece: ca.Function
+    creep: CreepSetup | None = None
+    creep_fn: ca.Function | None = None
+    s_index: int = 0                # first of the contact's 4 entries in s
+    row_start: int = 0              # first of its 5 constraint rows
+
+
+def piece_lookup(profile, name: str) -> ca.Function:
+    """Compiled SX lookup ``s -> [s0, y_0:4, z_0:4]`` of the cubic piece containing ``s``
+    (the end pieces extend beyond the profile's ends)."""
+    pp = profile.piecewise_polynomial()
+    s = ca.SX.sym("s")
+    x, n = pp.x, pp.c.shape[1]
+    out = ca.SX.zeros(9)
+    for k in range(n):
+        below = s >= x[k] if k > 0 else 1
+        above = s < x[k + 1] if k < n - 1 else 1
+        out += below * above * ca.DM(np.r_[x[k], pp.c[:, k, 0], pp.c[:, k, 1]])
+    return ca.Function(name, [s], [out])
+
+
+def add_wheelrail(model, joint: WheelRailJoint) -> WheelRailEntry:
+    """Record of one contact for ``model`` (a :class:`MultibodyModel` under construction)."""
+    body = model.scene.find(joint.body)
+    if not isinstance(body, RigidBody):
+        raise ParameterError(f"wheel/rail contact {joint.name!r}: body={joint.body!r} must be a rigid body (the wheelset)")
+    contact = joint.contact()
+    rows = model._rigid_indices(body.name)
+    q_body = model.q0[rows]
+    try:
+        point = contact.solve(q_body)
+    except SolverError as err:
+        raise ParameterError(f"wheel/rail contact {joint.name!r}: the {joint.side} wheel of {body.name!r} does not "
+                             f"meet its rail at the initial position ({err})") from None
+    if abs(point.gap_m) > PLACEMENT_TOLERANCE_M:
+        raise ParameterError(
+            f"wheel/rail contact {joint.name!r}: the {joint.side} wheel of {body.name!r} is {point.gap_m * 1e3:.2f} mm "
+            f"{'above' if point.gap_m > 0 else 'into'} its rail at the initial position (allowed "
+            f"{PLACEMENT_TOLERANCE_M * 1e3:g} mm); place the wheelset with symcat.wheelrail.wheelset_on_track")
+    s0 = point.s
+    head = contact.parameters(s0)[:6]
+    entry = WheelRailEntry(joint, contact, contact.library, body, rows, s0, head,
+                           piece_lookup(joint.wheel, f"{joint.name}_wheel_piece"),
+                           piece_lookup(joint.rail, f"{joint.name}_rail_piece"))
+    if joint.creep is not None:
+        entry.creep = creep_setup(joint, contact, point)
+        entry.creep_fn = creep_function(joint, entry.creep)
+    return entry
+
+
+def creep_setup(joint: WheelRailJoint, contact, point) -> CreepSetup:
+    """Hertz ellipse and Kalker coefficients at the nominal load and the initial contact point."""
+    cm = joint.creep
+    s1w, s2r = point.s[0], point.s[3]
+    # Profile.curvature is positive for hollows; Hertz wants convex positive.
+    k_wheel = -float(contact.wheel.curvature(s1w))
+    k_rail = -float(contact.rail.curvature(s2r))
+    try:
+        A, B = relative_curvatures(point.rolling_radius_m, k_wheel, k_rail, point.contact_angle_rad)
+        ellipse = hertz_contact(cm.nominal_normal_force_N, A, B)
+    except ParameterError as err:
+        raise ParameterError(f"wheel/rail contact {joint.name!r}: no Hertz ellipse at the initial contact point "
+                             f"({err})") from None
+    a, b = float(ellipse.semi_axis_a_m), float(ellipse.semi_axis_b_m)
+    c = kalker_coefficients(a / b, clamp=True)
+    f = cm.coefficient_factor
+    return CreepSetup(a, b, f * float(c.c11), f * float(c.c22), f * float(c.c23), f * float(c.c33),
+                      cm.nominal_normal_force_N)
+
+
+def _rotation(th):
+    e0, e1, e2, e3 = th[0], th[1], th[2], th[3]
+    e = ca.vertcat(e1, e2, e3)
+    skew = ca.vertcat(ca.horzcat(0, -e3, e2), ca.horzcat(e3, 0, -e1), ca.horzcat(-e2, e1, 0))
+    return (2 * e0**2 - 1) * ca.SX.eye(3) + 2 * (ca.mtimes(e, e.T) + e0 * skew)
+
+
+def _cubic(s, s0, c):
+    d = s - s0
+    return c[0] * d**3 + c[1] * d**2 + c[2] * d + c[3], 3 * c[0] * d**2 + 2 * c[1] * d + c[2]
+
+
+def creep_function(joint: WheelRailJoint, setup: CreepSetup) -> ca.Function:
+    """SX function ``(x, x_dot, s, p, N) -> (Q, [xi_x, xi_y, phi, Fx, Fy, Mz])``: generalized creep
+    forces on the wheelset coordinates ``x = [R, theta]`` (7) for surface parameters ``s``,
+    kernel parameters ``p`` (24) and normal force ``N`` (N)."""
+    x, xd = ca.SX.sym("x", 7), ca.SX.sym("xd", 7)
+    s, p, normal = ca.SX.sym("s", 4), ca.SX.sym("p", 24), ca.SX.sym("N")
+    side, r0, b, roll = p[0], p[1], p[2], p[5]
+    y_w, _ = _cubic(s[0], p[6], p[7:11])
+    z_w, _ = _cubic(s[0], p[6], p[11:15])
+    _, dy_r = _cubic(s[3], p[15], p[16:20])
+    _, dz_r = _cubic(s[3], p[15], p[20:24])
+    rho = r0 + z_w
+    u_w = ca.vertcat(rho * ca.sin(s[1]), side * (b + y_w), -rho * ca.cos(s[1]))
+    th, r_dot, th_dot = x[3:7], xd[:3], xd[3:7]
+    arm = ca.mtimes(_rotation(th), u_w)
+    e0, e1, e2, e3 = th[0], th[1], th[2], th[3]
+    g = ca.vertcat(ca.horzcat(-e1, e0, -e3, e2), ca.horzcat(-e2, e3, e0, -e1), ca.horzcat(-e3, -e2, e1, e0))
+    omega = 2 * ca.mtimes(g, th_dot)
+    v_point = r_dot + ca.cross(omega, arm)
+    c, sn = ca.cos(roll), ca.sin(roll)
+    t2r = ca.vertcat(0, c * side * dy_r - sn * dz_r, sn * side * dy_r + c * dz_r)
+    t1 = ca.DM([1.0, 0.0, 0.0])
+    n = side * ca.cross(t1, t2r)
+    n = n / ca.norm_2(n)
+    t2 = ca.cross(n, t1)
+    cm = joint.creep
+    speed = ca.sqrt(ca.dot(r_dot, t1) ** 2 + cm.reference_speed_m_s**2)
+    xi_x, xi_y, phi = ca.dot(v_point, t1) / speed, ca.dot(v_point, t2) / speed, ca.dot(omega, n) / speed
+    coeff = (setup.c11, setup.c22, setup.c23, setup.c33)
+    if cm.law == "linear":
+        fx, fy, mz = kalker_linear_forces(xi_x, xi_y, phi, setup.a_m, setup.b_m, coeff)
+    else:
+        # Smooth max(N, 0): the multiplier may dip below zero where the constraint holds the wheel down.
+        eps = 1e-3 * setup.nominal_normal_force_N
+        n_pos = 0.5 * (normal + ca.sqrt(normal**2 + eps**2))
+        scale = (n_pos / setup.nominal_normal_force_N) ** (1.0 / 3.0)
+        fx, fy, mz = polach_forces_casadi(xi_x, xi_y, phi, n_pos, setup.a_m * scale, setup.b_m * scale, coeff,
+                                          friction_coefficient=cm.friction_coefficient)
+    force = fx * t1 + fy * t2
+    moment = mz * n
+    # Virtual work: F . delta r_P + M . delta pi, with delta r_P and delta pi linear in the rates.
+    rates = ca.vertcat(r_dot, th_dot)
+    q_gen = ca.mtimes(ca.jacobian(v_point, rates).T, force) + ca.mtimes(ca.jacobian(omega, rates).T, moment)
+    return ca.Function(f"{joint.name}_creep", [x, xd, s, p, normal], [q_gen, ca.vertcat(xi_x, xi_y, phi, fx, fy, mz)],
+                       ["x", "x_dot", "s", "p", "N"], ["Q", "creep"])
+
+
+def polach_forces_casadi(xi_x, xi_y, phi, normal_N, a_m, b_m, coefficients,
+                         shear_modulus_Pa=SHEAR_MODULUS_STEEL_PA, friction_coefficient=0.3):
+    """Polach's creep forces (1999 method, as :func:`symcat.wheelrail.polach_forces`) in CasADi
+    symbols, with the resultant creepage regularized at zero (``sqrt(s^2 + 1e-24)``) so that the
+    law is differentiable there; ``mz`` is zero (Polach has no spin moment)."""
+    c11, c22, c23, _ = coefficients
+    g, mu = shear_modulus_Pa, friction_coefficient
+    bound = mu * normal_N
+    xi_y_edge = xi_y + phi * a_m
+    xi_y_c = ca.if_else(ca.fabs(xi_y_edge) > ca.fabs(xi_y), xi_y_edge, xi_y)
+    tiny = 1e-24
+    s = ca.sqrt(xi_x**2 + xi_y**2 + tiny)
+    s_c = ca.sqrt(xi_x**2 + xi_y_c**2 + tiny)
+    c_jj = ca.sqrt((c11 * xi_x) ** 2 + (c22 * xi_y) ** 2 + tiny * c11**2) / s
+    eps = g * math.pi * a_m * b_m * c_jj * s_c / (4.0 * bound)
+    force = 2.0 * bound / math.pi * (eps / (1.0 + eps**2) + ca.atan(eps))
+    k_spin = 1.0 + 6.3 * (1.0 - ca.exp(-a_m / b_m))
+    eps_m = 8.0 / 3.0 * g * b_m * ca.sqrt(a_m * b_m) * c23 * ca.fabs(xi_y_c) / (bound * k_spin)
+    delta = (eps_m**2 - 1.0) / (eps_m**2 + 1.0)
+    # sqrt((1 - delta^2)^3) written as (2 e / (e^2 + 1))^3: smooth where the spin term vanishes.
+    k_m = eps_m * (delta**3 / 3.0 - delta**2 / 2.0 + 1.0 / 6.0) - (2.0 * eps_m / (eps_m**2 + 1.0)) ** 3 / 3.0
+    f_spin = 9.0 / 16.0 * a_m * bound * k_m * k_spin * phi / s_c
+    return -force * xi_x / s_c, -force * xi_y / s_c + f_spin, 0 * xi_x
+
+
+# --- MX pieces for the multibody model ------------------------------------------------------
+def kernel_inputs(entry: WheelRailEntry, q: ca.MX, v: ca.MX, s: ca.MX, s_dot: ca.MX):
+    """Kernel arguments ``y``, ``y_dot`` and parameters ``p`` of one contact (MX)."""
+    i = entry.s_index
+    s_e, sd_e = s[i : i + 4], s_dot[i : i + 4]
+    y = ca.vertcat(q[entry.rows], s_e)
+    y_dot = ca.vertcat(v[entry.rows], sd_e)
+    p = ca.vertcat(ca.DM(entry.head), entry.wheel_piece(s_e[0]), entry.rail_piece(s_e[3]))
+    return y, y_dot, p
+
+
+def constraint_parts(model, q, v, s, s_dot, t, place):
+    """``(c, c_q, c_s, c_t, q_d)`` blocks of every contact (5 rows each); ``place`` puts a
+    block's columns at global coordinate columns."""
+    parts = []
+    for e in model.wheelrail:
+        kl = kernel_library(e.library)
+        y, y_dot, p = kernel_inputs(e, q, v, s, s_dot)
+        c = kl[f"{e.library}_c"](y, t, p)
+        c_y, c_t = kl[f"{e.library}_jac"](y, t, p)
+        cs = ca.MX(5, model.n_s)
+        cs[:, e.s_index : e.s_index + 4] = c_y[:, 7:11]
+        parts.append((c, place(c_y[:, :7], e.rows, model.n_q), cs, c_t, kl[f"{e.library}_gamma"](y, y_dot, t, p)))
+    return parts
+
+
+def creep_terms(model, q, v, s, s_dot, normal_N) -> tuple[ca.MX, ca.MX]:
+    """Generalized creep forces (n_q) and the creep record (6 per contact: ``xi_x, xi_y, phi``
+    (-, -, 1/m) and ``Fx, Fy, Mz`` (N, N, N m)) for the normal forces ``normal_N`` (one per
+    contact, N); contacts without a creep model contribute zeros."""
+    total = ca.MX(model.n_q, 1)
+    records = []
+    for k, e in enumerate(model.wheelrail):
+        if e.creep_fn is None:
+            records.append(ca.MX(6, 1))
+            continue
+        y, y_dot, p = kernel_inputs(e, q, v, s, s_dot)
+        q_gen, rec = e.creep_fn(y[:7], y_dot[:7], y[7:], p, normal_N[k])
+        total += ca.mtimes(_placement(e.rows, model.n_q).T, q_gen)
+        records.append(rec)
+    return total, (ca.vertcat(*records) if records else ca.MX(0, 1))
+
+
+def _placement(cols, n: int) -> ca.DM:
+    cols = list(cols)
+    return ca.DM(ca.Sparsity.triplet(len(cols), n, list(range(len(cols))), cols), 1.0)
+
+
+def has_creep(model) -> bool:
+    return any(e.creep_fn is not None for e in model.wheelrail)

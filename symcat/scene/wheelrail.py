@@ -1,0 +1,119 @@
+"""Wheel/rail contact of a rigid wheelset on a ground-fixed rail (seed paper, Section 4).
+
+A :class:`WheelRailJoint` is one wheel on one rail: four surface parameters and five
+constraints (seed eqs. 15-22, see :mod:`symcat.symbolic.wheelrail`), with the normal force as
+the Lagrange multiplier of the gap row. Its optional :class:`CreepModel` adds the tangential
+creep forces at the contact point (assembled in :mod:`symcat.assembly.wheelrail`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from ..errors import ParameterError
+
+CREEP_LAWS = ("linear", "polach")
+
+
+@dataclass
+class CreepModel:
+    """Creep forces of one contact.
+
+    The contact ellipse and Kalker's coefficients are computed once, by Hertz's theory at
+    ``nominal_normal_force_N`` and the local curvatures of the initial contact point (the
+    usual practice of linear analyses; their change with the contact point's position on the
+    profile is neglected). ``linear`` is Kalker's linear theory with these constant
+    coefficients. ``polach`` is Polach's saturating law with friction coefficient
+    ``friction_coefficient``; its ellipse grows with the actual normal force (the multiplier)
+    as ``(N / N_nominal)^(1/3)`` at fixed shape.
+
+    Parameters
+    ----------
+    law : {"linear", "polach"}
+    nominal_normal_force_N : float
+        Normal force for the contact ellipse (N), > 0: the static wheel load.
+    friction_coefficient : float
+        Coulomb friction coefficient of the ``polach`` law (-), in (0, 1].
+    coefficient_factor : float
+        Multiplies Kalker's coefficients (-), in (0, 1] (a common reduction for real rail
+        surfaces, e.g. 0.6-0.8).
+    reference_speed_m_s : float
+        Regularizes the rolling speed ``V`` in the creepages, ``sqrt(V^2 + v_ref^2)`` (m/s), > 0:
+        the creepages stay finite at rest.
+    """
+
+    law: str = "linear"
+    nominal_normal_force_N: float = 80e3
+    friction_coefficient: float = 0.3
+    coefficient_factor: float = 1.0
+    reference_speed_m_s: float = 0.01
+
+    def __post_init__(self):
+        if self.law not in CREEP_LAWS:
+            raise ParameterError(f"creep law={self.law!r}: must be one of {', '.join(CREEP_LAWS)}")
+        checks = (("nominal_normal_force_N", self.nominal_normal_force_N, 0.0, math.inf, "N"),
+                  ("friction_coefficient", self.friction_coefficient, 0.0, 1.0, "-"),
+                  ("coefficient_factor", self.coefficient_factor, 0.0, 1.0, "-"),
+                  ("reference_speed_m_s", self.reference_speed_m_s, 0.0, math.inf, "m/s"))
+        for name, value, lo, hi, unit in checks:
+            if not (isinstance(value, (int, float)) and lo < value <= hi):
+                raise ParameterError(f"creep {name}={value!r} {unit}: must be > {lo:g}" + (f" and <= {hi:g}" if hi < math.inf else ""))
+
+
+@dataclass
+class WheelRailJoint:
+    """One wheel of a rigid wheelset on its rail (constraint contact).
+
+    The wheelset body's frame has its origin on the axle centre and the axle along the body
+    ``y`` axis; the track runs along global ``x`` (tangent track) with ``y`` toward the left
+    rail and ``z`` up, the rail tops at ``z = 0`` (see :mod:`symcat.wheelrail.constraint_contact`).
+
+    Parameters
+    ----------
+    name : str
+    body : str
+        The wheelset (a rigid body).
+    side : {"left", "right"}
+        Which wheel: ``left`` is on the body's ``+y`` end and runs on the rail at ``y > 0``.
+    wheel, rail : symcat.wheelrail.Profile
+        Profiles (mirrored on the right).
+    wheelset : symcat.wheelrail.WheelsetDimensions, optional
+        Tape-circle distance and nominal radius (default 1.5 m, 0.46 m).
+    track : symcat.wheelrail.TrackCrossSection, optional
+        Gauge and rail inclination (default 1.435 m, as built into the rail profile).
+    cant_rad : float
+        Cant of the cross-section (rad).
+    form : {"railframe", "global"}
+        Constraint form: eq. 22 (default; needed by the embedded formulation) or eq. 21.
+    creep : CreepModel, optional
+        Creep forces; none (frictionless) by default.
+    """
+
+    name: str
+    body: str
+    side: str
+    wheel: object
+    rail: object
+    wheelset: object = None
+    track: object = None
+    cant_rad: float = 0.0
+    form: str = "railframe"
+    creep: CreepModel | None = field(default=None)
+
+    def __post_init__(self):
+        if self.side not in ("left", "right"):
+            raise ParameterError(f"wheel/rail contact {self.name!r}: side={self.side!r} must be 'left' or 'right'")
+        if self.creep is not None and not isinstance(self.creep, CreepModel):
+            raise ParameterError(f"wheel/rail contact {self.name!r}: creep={self.creep!r} must be a CreepModel or None")
+        if self.form not in ("railframe", "global"):
+            raise ParameterError(f"wheel/rail contact {self.name!r}: form={self.form!r} must be 'railframe' or 'global'")
+        if self.creep is not None and self.form != "railframe":
+            raise ParameterError(f"wheel/rail contact {self.name!r}: creep forces need form='railframe' (the "
+                                 "normal force is the multiplier of its gap row)")
+
+    def contact(self):
+        """The run-time contact (:class:`symcat.wheelrail.WheelRailContact`) of this joint."""
+        from ..wheelrail.constraint_contact import WheelRailContact
+
+        return WheelRailContact(self.wheel, self.rail, self.side, wheelset=self.wheelset, track=self.track,
+                                cant_rad=self.cant_rad, form=self.form)
