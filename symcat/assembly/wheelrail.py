@@ -25,6 +25,7 @@ import casadi as ca
 import numpy as np
 
 from ..codegen.library import kernel_library
+from .contact import _placement
 from ..errors import ParameterError, SolverError
 from ..scene.rigid import RigidBody
 from ..scene.wheelrail import WheelRailJoint
@@ -257,11 +258,6 @@ def creep_terms(model, q, v, s, s_dot, normal_N) -> tuple[ca.MX, ca.MX]:
         total += ca.mtimes(_placement(e.rows, model.n_q).T, q_gen)
         records.append(rec)
     return total, (ca.vertcat(*records) if records else ca.MX(0, 1))
-
-
-def _placement(cols, n: int) -> ca.DM:
-    cols = list(cols)
-    return ca.DM(ca.Sparsity.triplet(len(cols), n, list(range(len(cols))), cols), 1.0)
 
 
 def has_creep(model) -> bool:

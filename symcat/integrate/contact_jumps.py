@@ -17,7 +17,7 @@ import numpy as np
 
 from ..dae.initial import consistent_state
 from ..errors import SolverError
-from .failure import _split
+from .failure import split_state
 
 #: A lowest point this much below the followed one (m) triggers a jump.
 JUMP_TOLERANCE_M = 1e-7
@@ -31,7 +31,7 @@ def jump_contacts(form, x, z, t: float):
     model = form.model
     if not model.wheelrail:
         return x, z, []
-    parts = _split(form, x, z)
+    parts = split_state(form, x, z)
     q_full = model.q0.copy()
     q_full[model.free] = form.to_physical(parts["q"])
     s = parts["s"].copy()

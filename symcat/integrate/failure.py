@@ -8,7 +8,7 @@ import numpy as np
 from ..errors import SolverError
 
 
-def _split(form, x, z) -> dict:
+def split_state(form, x, z) -> dict:
     xb, zb = form.blocks()
     out = {k: np.asarray(x)[b.slice] for k, b in xb.items()}
     out.update({k: np.asarray(z)[b.slice] for k, b in zb.items() if k not in out})
@@ -37,7 +37,7 @@ def _dependent_rows(form, x, z, t) -> str:
     model = form.model
     if not 0 < model.n_c <= 2000:
         return ""
-    parts = _split(form, x, z)
+    parts = split_state(form, x, z)
     n_s = form.n_s
     qs, vs, ss, ws = ca.MX.sym("q", form.n_f), ca.MX.sym("v", form.n_f), ca.MX.sym("s", n_s), ca.MX.sym("w", n_s)
     k = form.terms(qs, vs, ss, ws, ca.MX(t), ca.MX.sym("sc", form.n_sc))

@@ -16,13 +16,14 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from ..assembly.multibody import MultibodyModel
+from ..assembly.wheelrail import GAP_ROW
 from ..dae.formulation import Formulation
 from ..assembly.sparse import to_scipy
 from ..dae.initial import CreepCoupling, consistent_state, kkt_solve
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
 from .contact_jumps import jump_contacts
-from .failure import failure
+from .failure import failure, split_state
 
 STAT_KEYS = ("nsteps", "nfevals", "nlinsetups", "netfails", "nniters", "nncfails")
 
@@ -280,7 +281,7 @@ def _left_window(model, form, x, z) -> bool:
 
 def _s_dot(form, x, z) -> np.ndarray:
     """Rates of the windowed arc lengths (sliding joints, then contacts)."""
-    parts = _split(form, x, z)
+    parts = split_state(form, x, z)
     # Algebraic arc lengths (embedded form, contacts): the largest velocity bounds s_dot well enough here.
     bound = np.abs(parts["v"]).max(initial=0.0)
     n = form.model.n_sliding  # wheel/rail surface parameters have no window
@@ -290,7 +291,7 @@ def _s_dot(form, x, z) -> np.ndarray:
 
 def _window_s(form, x, z) -> np.ndarray:
     """Arc lengths of the sliding joints, then of the contacts."""
-    parts = _split(form, x, z)
+    parts = split_state(form, x, z)
     return np.r_[parts["s"][: form.model.n_sliding], parts.get("sc", np.zeros(0))]
 
 
@@ -304,13 +305,6 @@ def _update_windows(model, form, x, z) -> bool:
     for sl, s_k in zip(model.windowed(), s):
         moved |= model.set_window(sl, s_k)
     return moved
-
-
-def _split(form, x, z) -> dict:
-    xb, zb = form.blocks()
-    out = {k: np.asarray(x)[b.slice] for k, b in xb.items()}
-    out.update({k: np.asarray(z)[b.slice] for k, b in zb.items() if k not in out})
-    return out
 
 
 def _result(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
@@ -329,7 +323,7 @@ def _result(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
 def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
     model = form.model
     n_f, n_s = form.n_f, form.n_s
-    parts = [_split(form, x, z) for x, z in zip(xs, zs)]
+    parts = [split_state(form, x, z) for x, z in zip(xs, zs)]
     q = np.tile(model.q0, (len(parts), 1))
     v = np.zeros_like(q)
     for k, p in enumerate(parts):
@@ -357,7 +351,7 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
     acc = np.zeros_like(q)
     lam = np.zeros((len(parts), model.n_c))
     s_dot = np.zeros((len(parts), n_s))
-    normal_rows = [e.row_start + 2 for e in model.wheelrail]  # the gap rows (lam: augmented layout)
+    normal_rows = [e.row_start + GAP_ROW for e in model.wheelrail]  # the gap rows (lam: augmented layout)
     creep_record = np.zeros((len(parts), 6 * len(model.wheelrail)))
     creep_fn = form.creep_function() if model.wheelrail else None
     pos, vel, kin, pot = (np.zeros(len(parts)) for _ in range(4))
