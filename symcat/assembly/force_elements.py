@@ -6,7 +6,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..scene.contact import PenaltyContact
-from ..scene.forces import PointLoad, RotationalSpring, SpringDamper
+from ..scene.forces import Bushing, PointLoad, RotationalSpring, SpringDamper
 from ..scene.joints import perpendiculars, unit
 
 
@@ -48,7 +48,33 @@ def add_force(model, force):
         values = {}
         model._vectors(values, a, "i", z=unit(force.axis), x=x)
         model._vectors(values, b, "j", x=x)
-        values.update(phi0=force.angle0, k=force.stiffness, c=force.damping)
+        values.update(phi0=force.angle0, k=force.stiffness, c=force.damping, rate=force.rate)
         model._add(f"rotspring_{a.kind}_{b.kind}", force.name, [a, b], values, model.force_groups)
         return
+    if isinstance(force, Bushing):
+        add_bushing(model, force)
+        return
     raise ParameterError(f"unsupported force element {type(force).__name__}")
+
+
+def add_bushing(model, force: Bushing) -> None:
+    """Record a :class:`Bushing`: its point and axes in both bodies' frames and its law."""
+    a, b = model.side(force.body_i, force.at), model.side(force.body_j, force.at)
+    if a.kind != "rigid" or b.kind not in ("rigid", "ground"):
+        raise ParameterError(f"bushing {force.name!r}: body_i must be a rigid body and body_j a rigid body or 'ground'")
+    axes = np.eye(3) if force.axes is None else np.asarray(force.axes, float)
+    if axes.shape != (3, 3) or not np.allclose(axes @ axes.T, np.eye(3), atol=1e-9) or np.linalg.det(axes) < 0:
+        raise ParameterError(f"bushing {force.name!r}: axes={force.axes}: rows must be orthonormal and right-handed")
+    values = {f"ui_{k}": a.local["u"][k] for k in range(3)}
+    values.update({f"uj_{k}": b.local["u"][k] for k in range(3)})
+    model._vectors(values, a, "i", x=axes[0], y=axes[1], z=axes[2])
+    model._vectors(values, b, "j", x=axes[0], y=axes[1], z=axes[2])
+    for attr, key in Bushing.LAW:
+        vec = np.asarray(getattr(force, attr), float)
+        if vec.shape != (3,) or not np.all(np.isfinite(vec)):
+            raise ParameterError(f"bushing {force.name!r}: {attr}={getattr(force, attr)}: give 3 finite values")
+        if attr != "preload" and np.any(vec < 0):
+            raise ParameterError(f"bushing {force.name!r}: {attr}={tuple(vec.tolist())}: must be >= 0 "
+                                 f"({dict(Bushing.UNITS)[attr]})")
+        values.update({f"{key}_{k}": vec[k] for k in range(3)})
+    model._add(f"bushing_{a.kind}_{b.kind}", force.name, [a, b], values, model.force_groups)

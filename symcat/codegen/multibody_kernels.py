@@ -100,10 +100,26 @@ def force_functions(name: str) -> list[ca.Function]:
             force = par["k"] * stretch + par["k3"] * stretch**3 + par["c"] * m_dot
             slack = ca.logic_and(par["tension_only"] > 0.5, ca.logic_or(stretch <= 0, force < 0))
             force = ca.if_else(slack, 0, force)
+            q = -force * ca.gradient(m, y)
+        elif name.startswith("bushing"):
+            q = _bushing_force(m, m_dot, y, par)
         else:
-            force = par["k"] * (m - par["phi0"]) + par["c"] * m_dot
-        q = -force * ca.gradient(m, y)
+            force = par["k"] * (m - par["phi0"] - par["rate"] * t) + par["c"] * (m_dot - par["rate"])
+            q = -force * ca.gradient(m, y)
     return _with_jacobian(ca.Function(name, [y, y_dot, t, p], [q], ["y", "y_dot", "t", "p"], ["q"], OPTS))
+
+
+def _bushing_force(m, m_dot, y, par):
+    """Generalized force of a bushing: ``-J^T f`` with ``J = dm/dy`` and, per axis,
+    ``f = k d + c d_dot - f0 + kstop (max(d - gap, 0) + min(d + gap, 0))`` (translations; the stop
+    force is continuous at the free play's edge) and ``f = kr theta + cr theta_dot`` (rotations)."""
+    vec = lambda n: ca.vertcat(*(par[f"{n}_{k}"] for k in range(3)))  # noqa: E731
+    d, d_dot, theta, theta_dot = m[0:3], m_dot[0:3], m[3:6], m_dot[3:6]
+    gap = vec("gap")
+    stop = ca.fmax(d - gap, 0) + ca.fmin(d + gap, 0)
+    f = ca.vertcat(vec("k") * d + vec("c") * d_dot - vec("f0") + vec("kstop") * stop,
+                   vec("kr") * theta + vec("cr") * theta_dot)
+    return -ca.mtimes(ca.jacobian(m, y).T, f)
 
 
 CONTACT_LAW = ("k", "c", "delta")

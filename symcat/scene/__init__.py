@@ -1,7 +1,7 @@
 """What the user describes: ANCF and rigid bodies, joints, force elements, supports and loads."""
 from .ancf import AncfBody
 from .contact import PenaltyContact
-from .forces import PointLoad, RotationalSpring, SpringDamper
+from .forces import Bushing, PointLoad, RotationalSpring, SpringDamper
 from .joints import GROUND, Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical
 from .loads import NodalForce, SlopeMoment
 from .rigid import RigidBody
@@ -10,6 +10,6 @@ from .sections import Material, Section
 from .wheelrail import CreepModel, WheelRailJoint
 
 __all__ = [
-    "GROUND", "AncfBody", "CreepModel", "Driving", "Fixed", "Material", "NodalForce", "PenaltyContact", "PointLoad", "Prismatic", "Revolute",
+    "GROUND", "AncfBody", "Bushing", "CreepModel", "Driving", "Fixed", "Material", "NodalForce", "PenaltyContact", "PointLoad", "Prismatic", "Revolute",
     "RigidBody", "RotationalSpring", "Scene", "Section", "SlidingJoint", "SlopeMoment", "Spherical", "SpringDamper", "WheelRailJoint",
 ]

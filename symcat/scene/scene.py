@@ -9,14 +9,14 @@ import numpy as np
 from ..errors import ParameterError
 from .ancf import AncfBody
 from .contact import PenaltyContact
-from .forces import PointLoad, RotationalSpring, SpringDamper
+from .forces import Bushing, PointLoad, RotationalSpring, SpringDamper
 from .joints import Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical
 from .loads import NodalForce, SlopeMoment
 from .rigid import RigidBody
 from .wheelrail import WheelRailJoint
 
 JOINT_TYPES = (Spherical, Revolute, Prismatic, Fixed, Driving, SlidingJoint, WheelRailJoint)
-FORCE_TYPES = (SpringDamper, RotationalSpring, PointLoad, PenaltyContact)
+FORCE_TYPES = (SpringDamper, Bushing, RotationalSpring, PointLoad, PenaltyContact)
 
 
 @dataclass
