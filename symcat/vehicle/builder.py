@@ -1,0 +1,183 @@
+"""Assemble the seed paper's vehicle (Figures 8 and 9) into a :class:`symcat.scene.Scene`.
+
+Topology (each bogie, centre ``x_b``; ``x`` forward, ``y`` left, ``z`` up, rail top at ``z = 0``):
+
+- two **wheelsets** at ``x_b +- semi_wheelbase``, each wheel on its rail by a
+  :class:`WheelRailJoint` (constraint contact, creep forces optional);
+- two **equalizer bars** (left, right) resting on the axleboxes of both wheelsets through
+  journal pads: a :class:`Bushing` at each axlebox (on the axle line, so the wheelset's spin does
+  not move it) with the primary longitudinal and lateral stiffness and a stiff vertical pad;
+- the **frame** on the equalizer bars: two vertical equalizer springs per bar (the primary
+  vertical stiffness and damping) and a guide at the bar's centre (stiff in x and y, holding its
+  roll);
+- the **bolster** on the frame: the secondary suspension (one bushing per side with the
+  benchmark's stiffness, damping and lateral bump stop) and the anti-roll bar (torsion about x);
+- the **car body** on both bolsters by a centre plate: a :class:`Revolute` about the vertical
+  axis with the secondary yaw stiffness as a :class:`RotationalSpring`.
+
+Every suspension element starts undeflected, with the static load of the symmetric vehicle as
+its preload, so the vehicle starts in equilibrium up to the wheel/rail contacts (whose normal
+forces are multipliers). The leading wheelset of each bogie is driven at the forward speed,
+either by a driving constraint on its centre (seed paper: ``V = 17 m/s``) or by a traction
+motor (a speed servo between frame and wheelset).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..scene import Bushing, CreepModel, Driving, Revolute, RigidBody, RotationalSpring, Scene, WheelRailJoint
+from ..wheelrail import WheelsetDimensions, wheelset_on_track
+from .parameters import VehicleParameters
+
+BOGIES = ("b1", "b2")          # front (x > 0) and rear
+WHEELSETS = ("ws1", "ws2")     # leading and trailing within a bogie
+SIDES = ("left", "right")
+DRIVES = ("constraint", "torque")
+#: Gain of the traction servo (N m per rad/s of spin error).
+SERVO_DAMPING_N_M_S = 2e4
+
+
+@dataclass
+class VehicleLayout:
+    """Names of what :func:`add_vehicle` put in the scene."""
+
+    car_body: str = "car_body"
+    wheelsets: list = field(default_factory=list)           # body names, front to rear
+    contacts: dict = field(default_factory=dict)            # wheelset -> {side: joint name}
+    frames: list = field(default_factory=list)
+    bolsters: list = field(default_factory=list)
+    equalizers: list = field(default_factory=list)
+    placements: dict = field(default_factory=dict)          # wheelset -> WheelsetPlacement
+    parameters: VehicleParameters | None = None
+
+    @property
+    def contact_names(self) -> list[str]:
+        return [self.contacts[w][s] for w in self.wheelsets for s in SIDES]
+
+
+def add_vehicle(scene: Scene, pair, *, speed_ms: float, parameters: VehicleParameters | None = None,
+                creep: str = "linear", friction_coefficient: float = 0.3, drive: str = "constraint",
+                lateral_offset_m: float = 0.0, x_m: float = 0.0, contact_form: str = "railframe") -> VehicleLayout:
+    """Add the vehicle, centred at ``x_m`` on tangent track, moving at ``speed_ms`` (m/s).
+
+    Parameters
+    ----------
+    scene : Scene
+        Receives 13 rigid bodies, their suspensions, 8 wheel/rail contacts and the drive.
+    pair : ProfilePair
+        Wheel and rail profiles (:func:`symcat.wheelrail.profile_pair`).
+    speed_ms : float
+        Forward speed (m/s).
+    parameters : VehicleParameters, optional
+        Default: the Manchester benchmark vehicle with symcat's bolster and equalizer values.
+    creep : {"none", "linear", "polach"}
+        Creep force law of every contact.
+    friction_coefficient : float
+        For ``"polach"``.
+    drive : {"constraint", "torque"}
+        Leading wheelsets driven by a constraint on the forward position, or by a traction
+        servo (torque between frame and wheelset holding the spin ``V / r0``).
+    lateral_offset_m : float
+        Initial lateral displacement of the whole vehicle toward the left rail (m).
+    x_m : float
+        Initial position of the vehicle centre along the track (m).
+    contact_form : {"railframe", "global"}
+        Form of the contact constraints (seed eq. 22 or 21).
+    """
+    p = parameters or VehicleParameters()
+    if drive not in DRIVES:
+        raise ParameterError(f"drive={drive!r}: must be one of {', '.join(DRIVES)}")
+    if creep not in ("none", "linear", "polach"):
+        raise ParameterError(f"creep={creep!r}: must be none, linear or polach")
+    if not speed_ms > 0:
+        raise ParameterError(f"speed_ms={speed_ms!r}: must be > 0 (m/s)")
+    loads = p.static_loads_N()
+    layout = VehicleLayout(parameters=p)
+    v = (speed_ms, 0.0, 0.0)
+    y0 = lateral_offset_m
+    scene.add(RigidBody("car_body", p.car_body_mass_kg, p.car_body_inertia_kg_m2, (x_m, y0, p.car_body_height_m),
+                        velocity=v))
+    creep_model = None
+    if creep != "none":
+        creep_model = CreepModel(creep, nominal_normal_force_N=loads["wheel"], friction_coefficient=friction_coefficient)
+    dims = WheelsetDimensions(p.tape_circle_distance_m, p.nominal_rolling_radius_m)
+    for bogie, sign in zip(BOGIES, (1.0, -1.0)):
+        xb = x_m + sign * p.bogie_semi_distance_m
+        _add_bogie(scene, layout, p, loads, bogie, xb, y0, v, pair, dims, creep_model, drive, speed_ms, contact_form)
+    return layout
+
+
+def _add_bogie(scene, layout, p, loads, bogie, xb, y0, v, pair, dims, creep_model, drive, speed, form):
+    frame, bolster = f"{bogie}_frame", f"{bogie}_bolster"
+    layout.frames.append(frame)
+    layout.bolsters.append(bolster)
+    scene.add(RigidBody(frame, p.frame_mass_kg, p.frame_inertia_kg_m2, (xb, y0, p.frame_height_m), velocity=v))
+    scene.add(RigidBody(bolster, p.bolster_mass_kg, p.bolster_inertia_kg_m2, (xb, y0, p.bolster_height_m), velocity=v))
+    a = p.suspension_semi_spacing_m
+    up = np.array([0.0, 0.0, 1.0])
+    # Bolster on the frame: secondary suspension per side, anti-roll bar at the centre.
+    for side, ys in zip(SIDES, (a, -a)):
+        scene.add(Bushing(f"{bogie}_secondary_{side}", frame, bolster, at=(xb, y0 + ys, p.secondary_height_m),
+                          stiffness=p.secondary_stiffness_N_m, damping=p.secondary_damping_N_s_m,
+                          preload=tuple(loads["secondary"] * up), clearance=(0.0, p.bump_stop_clearance_m, 0.0),
+                          stop_stiffness=(0.0, p.bump_stop_stiffness_N_m, 0.0)))
+    scene.add(Bushing(f"{bogie}_anti_roll_bar", frame, bolster, at=(xb, y0, p.secondary_height_m),
+                      rotational_stiffness=(p.anti_roll_stiffness_N_m_rad, 0.0, 0.0)))
+    # Car body on the bolster: centre plate (yaw only) with the secondary yaw stiffness.
+    scene.add(Revolute(f"{bogie}_centre_plate", bolster, layout.car_body, at=(xb, y0, p.centre_plate_height_m),
+                       axis=(0.0, 0.0, 1.0)))
+    scene.add(RotationalSpring(f"{bogie}_yaw_stiffness", bolster, layout.car_body, axis=(0.0, 0.0, 1.0),
+                               stiffness=p.secondary_yaw_stiffness_N_m_rad))
+    placed = {}
+    for ws, sign in zip(WHEELSETS, (1.0, -1.0)):
+        name = f"{bogie}_{ws}"
+        xw = xb + sign * p.semi_wheelbase_m
+        try:
+            placed[ws] = wheelset_on_track(pair.wheel, pair.rail, y0, x_m=xw, wheelset=dims)
+        except ParameterError as err:
+            raise ParameterError(f"lateral_offset_m={y0:g}: wheelset {name}: {err}") from None
+        pl = placed[ws]
+        r_mean = 0.5 * (pl.contacts["left"].rolling_radius_m + pl.contacts["right"].rolling_radius_m)
+        spin = pl.rotation[:, 1] * speed / r_mean
+        scene.add(RigidBody(name, p.wheelset_mass_kg, p.wheelset_inertia_kg_m2, tuple(pl.position_m),
+                            rotation=pl.rotation, velocity=v, angular_velocity=tuple(spin)))
+        layout.wheelsets.append(name)
+        layout.placements[name] = pl
+        layout.contacts[name] = {}
+        for side in SIDES:
+            joint = f"{name}_{side}"
+            scene.add(WheelRailJoint(joint, name, side, pair.wheel, pair.rail, wheelset=dims, creep=creep_model,
+                                     form=form))
+            layout.contacts[name][side] = joint
+        if ws == "ws1":
+            if drive == "constraint":
+                scene.add(Driving(f"{name}_drive", name, direction=(1.0, 0.0, 0.0), velocity=speed))
+            else:
+                scene.add(RotationalSpring(f"{name}_traction", frame, name, axis=(0.0, 1.0, 0.0),
+                                           damping=SERVO_DAMPING_N_M_S, rate=speed / r_mean))
+    # Equalizer bars on the axleboxes; the frame on the equalizer springs.
+    for side, ys in zip(SIDES, (a, -a)):
+        eq = f"{bogie}_equalizer_{side}"
+        layout.equalizers.append(eq)
+        scene.add(RigidBody(eq, p.equalizer_mass_kg, p.equalizer_inertia_kg_m2, (xb, y0 + ys, p.equalizer_height_m),
+                            velocity=v))
+        kx, ky, _ = p.primary_stiffness_N_m
+        cx, cy, cz = p.primary_damping_N_s_m
+        for ws in WHEELSETS:
+            pl = placed[ws]
+            box = pl.position_m + pl.rotation[:, 1] * ys
+            scene.add(Bushing(f"{bogie}_{ws}_journal_{side}", eq, f"{bogie}_{ws}", at=tuple(box),
+                              stiffness=(kx, ky, p.journal_pad_stiffness_N_m), damping=(cx, cy, 0.0),
+                              preload=(0.0, 0.0, -loads["journal"])))
+        for k, dx in enumerate((p.equalizer_spring_offset_m, -p.equalizer_spring_offset_m)):
+            scene.add(Bushing(f"{bogie}_equalizer_spring_{side}_{k + 1}", eq, frame,
+                              at=(xb + dx, y0 + ys, p.equalizer_spring_height_m),
+                              stiffness=(0.0, 0.0, p.primary_stiffness_N_m[2]), damping=(0.0, 0.0, cz),
+                              preload=(0.0, 0.0, loads["equalizer_spring"])))
+        g = p.equalizer_guide_stiffness_N_m
+        scene.add(Bushing(f"{bogie}_equalizer_guide_{side}", frame, eq, at=(xb, y0 + ys, p.equalizer_height_m),
+                          stiffness=(g, g, 0.0), rotational_stiffness=(p.equalizer_roll_stiffness_N_m_rad, 0.0, 0.0),
+                          rotational_damping=(p.equalizer_roll_damping_N_m_s_rad, 0.0, 0.0)))

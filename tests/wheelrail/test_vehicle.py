@@ -1,0 +1,80 @@
+"""The seed paper's vehicle: static wheel loads, symmetry, numerical convergence, bad input."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from symcat.assembly.multibody import MultibodyModel
+from symcat.errors import ParameterError
+from symcat.integrate import simulate
+from symcat.model import load_model
+from symcat.scene import Scene
+from symcat.vehicle import VehicleParameters, add_vehicle, wheel_forces
+from symcat.wheelrail import profile_pair
+
+G = 9.81
+
+
+def _run(profile="conical", creep="linear", speed=17.0, offset=0.0, t_end=0.2, rtol=1e-7, drive="constraint",
+         n_out=20):
+    scene = Scene(gravity=(0.0, 0.0, -G))
+    layout = add_vehicle(scene, profile_pair(profile, 0.05), speed_ms=speed, creep=creep, lateral_offset_m=offset,
+                         drive=drive)
+    res = simulate(MultibodyModel(scene), t_end, index="ggl", rtol=rtol, n_out=n_out, progress=False)
+    return layout, res, wheel_forces(res, layout)
+
+
+def test_static_wheel_loads_sum_to_the_weight_and_follow_the_load_path():
+    """At (almost) rest and centred, every wheel carries its share of the weight, computed
+    independently from the load path car body -> bolsters -> frames -> equalizers -> axleboxes."""
+    layout, res, forces = _run(creep="none", speed=0.01, t_end=0.05, n_out=5)
+    p = layout.parameters
+    q = np.array([forces[n]["Q_N"] for n in layout.contact_names])           # (8, outputs)
+    np.testing.assert_allclose(q.sum(axis=0), p.total_mass_kg * G, rtol=1e-7)
+    np.testing.assert_allclose(q, p.static_loads_N()["wheel"], rtol=1e-6)
+    # Frictionless contacts on a 1:20 tread: the normal force is Q / cos(contact angle).
+    angle = layout.placements["b1_ws1"].contacts["left"].contact_angle_rad
+    np.testing.assert_allclose(forces["b1_ws1_left"]["normal_N"], q[0] / np.cos(angle), rtol=1e-6)
+    assert res.position_drift.max() < 1e-9
+
+
+def test_centred_vehicle_stays_symmetric_at_speed_on_s1002():
+    layout, res, forces = _run(profile="s1002_uic60", t_end=0.2)
+    for w in layout.wheelsets:
+        assert np.abs(res.coordinate(f"{w}.y")).max() < 1e-8
+        left, right = forces[f"{w}_left"]["normal_N"], forces[f"{w}_right"]["normal_N"]
+        np.testing.assert_allclose(left, right, rtol=1e-6)
+    q = np.array([forces[n]["Q_N"] for n in layout.contact_names])
+    np.testing.assert_allclose(q.sum(axis=0), layout.parameters.total_mass_kg * G, rtol=1e-4)
+
+
+def test_lateral_motion_converges_with_the_tolerance_and_does_not_depend_on_the_drive():
+    """A displaced vehicle on coned wheels: the wheelsets' lateral motion at rtol 1e-7 and 1e-8 agree,
+    and driving by a constraint or by traction servos gives the same motion (the drive only
+    holds the speed)."""
+    kw = dict(profile="conical", offset=0.002, t_end=0.3, n_out=15)
+    layout, fine, f_fine = _run(rtol=1e-8, **kw)
+    _, coarse, f_coarse = _run(rtol=1e-7, **kw)
+    _, servo, _ = _run(rtol=1e-7, drive="torque", **kw)
+    y = lambda r: np.array([r.coordinate(f"{w}.y") for w in layout.wheelsets])  # noqa: E731
+    assert np.abs(y(fine)).max() > 1e-3                 # it moves ...
+    np.testing.assert_allclose(y(coarse), y(fine), atol=2e-6)
+    np.testing.assert_allclose(y(servo), y(fine), atol=5e-5)
+    n_fine = np.array([f_fine[n]["normal_N"] for n in layout.contact_names])
+    n_coarse = np.array([f_coarse[n]["normal_N"] for n in layout.contact_names])
+    np.testing.assert_allclose(n_coarse, n_fine, rtol=1e-3)
+
+
+def test_bad_vehicle_input_names_the_item():
+    scene = Scene(gravity=(0.0, 0.0, -G))
+    pair = profile_pair("s1002_uic60", 0.05)
+    with pytest.raises(ParameterError, match="drive='hover'"):
+        add_vehicle(scene, pair, speed_ms=17.0, drive="hover")
+    with pytest.raises(ParameterError, match="speed_ms=-1"):
+        add_vehicle(Scene(), pair, speed_ms=-1.0)
+    with pytest.raises(ParameterError, match="lateral_offset_m=0.05"):
+        add_vehicle(Scene(), pair, speed_ms=17.0, lateral_offset_m=0.05)
+    with pytest.raises(ParameterError, match="frame_mass_kg=-3"):
+        VehicleParameters(frame_mass_kg=-3.0)
+    with pytest.raises(ParameterError, match="lateral_offset_m"):
+        load_model("vehicle").resolve({"lateral_offset_m": 0.02})
