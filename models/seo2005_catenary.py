@@ -59,7 +59,7 @@ from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError
 from symcat.integrate import simulate
 from symcat.model import Model, ModelOutput, Parameter
-from symcat.scene import (AncfBody, Driving, Material, PenaltyContact, PointLoad, Prismatic, Revolute, RigidBody,
+from symcat.scene import (AncfBody, Driving, Fixed, Material, PenaltyContact, PointLoad, Prismatic, Revolute, RigidBody,
                           Scene, Section, SlidingJoint, SpringDamper)
 
 G = 9.81
@@ -102,9 +102,10 @@ def _rod(name, mass, a, b, velocity):
     return RigidBody(name, mass, (0.01 * j, j, j), tuple((a + b) / 2), rotation, velocity=velocity)
 
 
-def geometry(x0: float) -> dict:
-    """Global points of the pantograph with the base hinge under ``x0`` (see the module doc)."""
-    b = np.array([x0, 0.0, -B_DEPTH])
+def geometry(x0: float, z0: float = 0.0) -> dict:
+    """Global points of the pantograph with the base hinge under ``x0``, the wire at height
+    ``z0`` (see the module doc)."""
+    b = np.array([x0, 0.0, z0 - B_DEPTH])
     a = b + [0.0, 0.0, APEX]
     cos_b = (L1**2 + APEX**2 - L2**2) / (2 * L1 * APEX)
     e = b + L1 * np.array([-np.sqrt(1 - cos_b**2), 0.0, cos_b])
@@ -115,46 +116,66 @@ def geometry(x0: float) -> dict:
             "lower_mid": (b + e) / 2}
 
 
-def build(p: dict) -> Scene:
+def build(p: dict, z0: float = 0.0, base: str | None = None, scene: Scene | None = None,
+          carrier_fixed: bool = False) -> Scene:
+    """The catenary and the pantograph with the wire at height ``z0`` (m). The pantograph's base
+    is a 50 kg carrier driven along the wire (``base=None``; held fixed with ``carrier_fixed``)
+    or the rigid body ``base`` already in ``scene`` (a car body)."""
+    scene = add_catenary(Scene(gravity=(0.0, 0.0, -G)) if scene is None else scene, p, z0)
+    add_pantograph(scene, p, z0, base, carrier_fixed)
+    return scene
+
+
+def add_catenary(scene: Scene, p: dict, z0: float = 0.0) -> Scene:
+    """The contact wire (pinned ends, along x at height ``z0``) and its droppers."""
     length, n_el = p["wire_length"], p["n_elements"]
     ea = E_MOD * AREA
     section = Section.rectangle(SIDE, SIDE)
-    wire = AncfBody.straight("wire", p["element"], [0, 0, 0], [length, 0, 0], n_el, Material(E_MOD, RHO), section,
+    wire = AncfBody.straight("wire", p["element"], [0, 0, z0], [length, 0, z0], n_el, Material(E_MOD, RHO), section,
                              prestrain=p["tension"] / ea, damping_axial=p["wire_damping"],
                              damping_bending=p["wire_damping"])
     wire.pin(0).pin(-1)
     if p["element"] == "beam3d":
         wire.fix(0, ["z_y", "y_z"])
-    scene = Scene(gravity=(0.0, 0.0, -G))
     scene.add(wire)
     spacing = length / n_el
     stretch = RHO * AREA * G * spacing / DROPPER_K
     for k in range(1, n_el):
         x = k * spacing
-        scene.add(SpringDamper(f"dropper_{k}", ("wire", k), "ground", at_i=(x, 0, 0), at_j=(x, 0, DROPPER_LENGTH),
+        scene.add(SpringDamper(f"dropper_{k}", ("wire", k), "ground", at_i=(x, 0, z0), at_j=(x, 0, z0 + DROPPER_LENGTH),
                                stiffness=DROPPER_K, damping=DROPPER_C, free_length=DROPPER_LENGTH - stretch,
                                tension_only=True))
-    g = geometry(p["start"])
+    return scene
+
+
+def add_pantograph(scene: Scene, p: dict, z0: float = 0.0, base: str | None = None, carrier_fixed: bool = False):
+    """The four-body pantograph under the wire at ``p["start"]`` and its contact (module doc)."""
+    g = geometry(p["start"], z0)
     vel = (p["speed"], 0.0, 0.0)
-    scene.add(RigidBody("carrier", 50.0, (5.0, 5.0, 5.0), tuple(g["B"]), velocity=vel))
+    if base is None:
+        base = "carrier"
+        scene.add(RigidBody("carrier", 50.0, (5.0, 5.0, 5.0), tuple(g["B"]), velocity=vel))
+        if carrier_fixed:
+            scene.add(Fixed("carrier_fixed", "carrier", "ground", at=tuple(g["B"])))
+        else:
+            scene.add(Prismatic("track", "carrier", "ground", at=tuple(g["B"]), axis=(1, 0, 0)))
+            scene.add(Driving("drive", "carrier", direction=(1, 0, 0), velocity=p["speed"]))
     scene.add(_rod("lower_arm", 8.0, g["B"], g["E"], vel))
     scene.add(_rod("upper_arm", 8.0, g["E"], g["A"], vel))
     scene.add(RigidBody("plunger", 4.0, (0.02, 0.02, 0.02), tuple(g["plunger"]), velocity=vel))
     scene.add(RigidBody("panhead", 2.0, (0.375, 0.01, 0.375), tuple(g["head"]), velocity=vel))
     y = (0.0, 1.0, 0.0)
-    scene.add(Prismatic("track", "carrier", "ground", at=tuple(g["B"]), axis=(1, 0, 0)))
-    scene.add(Driving("drive", "carrier", direction=(1, 0, 0), velocity=p["speed"]))
-    scene.add(Revolute("base_hinge", "lower_arm", "carrier", at=tuple(g["B"]), axis=y))
+    scene.add(Revolute("base_hinge", "lower_arm", base, at=tuple(g["B"]), axis=y))
     scene.add(Revolute("elbow", "upper_arm", "lower_arm", at=tuple(g["E"]), axis=y))
     scene.add(Revolute("apex", "plunger", "upper_arm", at=tuple(g["A"]), axis=y))
     scene.add(Prismatic("guide", "panhead", "plunger", at=tuple(g["guide"]), axis=(0, 0, 1)))
     scene.add(SpringDamper("primary_k1", "plunger", "panhead", at_i=tuple(g["guide"]), at_j=tuple(g["head"]),
                            stiffness=40000.0, damping=100.0))
-    scene.add(SpringDamper("damper_k2", "carrier", "lower_arm", at_i=tuple(g["damper_base"]),
+    scene.add(SpringDamper("damper_k2", base, "lower_arm", at_i=tuple(g["damper_base"]),
                            at_j=tuple(g["lower_mid"]), stiffness=0.0, damping=200.0))
     scene.add(SpringDamper("leveller_k3", "plunger", "upper_arm", at_i=tuple(g["lever"]), at_j=tuple(g["level"]),
                            stiffness=5000.0, damping=50.0))
-    scene.add(SpringDamper("coupling_rod", "carrier", "upper_arm", at_i=tuple(g["rod_base"]),
+    scene.add(SpringDamper("coupling_rod", base, "upper_arm", at_i=tuple(g["rod_base"]),
                            at_j=tuple(g["rod_arm"]), stiffness=p["rod_stiffness"], damping=500.0))
     scene.add(PointLoad("uplift", "plunger", force=(0.0, 0.0, p["uplift"])))
     if p["contact"] == "bilateral":
