@@ -77,12 +77,20 @@ def build(p: dict):
     layout = add_vehicle(scene, profile_pair(p["profile"], 0.05), speed_ms=p["speed"],
                          creep={"nonlinear": "polach"}.get(p["creep"], p["creep"]),
                          friction_coefficient=p["friction_coefficient"], lateral_offset_m=p["lateral_offset_m"],
-                         x_m=p["start"], parameters=VehicleParameters())
+                         x_m=p["start"], parameters=VehicleParameters(), car_body_load_N=_roof_load_N(sub, eq))
     cat.add_catenary(scene, p, WIRE_HEIGHT_M)
     cat.add_pantograph(scene, p, WIRE_HEIGHT_M, base=layout.car_body)
     model = MultibodyModel(scene)
     _start_from(model, sub, eq)
     return model, layout, eq
+
+
+def _roof_load_N(sub, eq) -> float:
+    """What the pantograph puts on the roof at equilibrium: its weight plus the wire's push."""
+    mass = sum(b.mass for b in sub.scene.rigid_bodies if b.name in PANTOGRAPH)
+    if "contact" in eq.contact_force_N:                      # penalty contact
+        return mass * G + float(eq.contact_force_N["contact"])
+    return mass * G - float(eq.reactions_N["contact"][2])  # sliding joint: reaction on the pan-head
 
 
 def _start_from(model, sub, eq) -> None:

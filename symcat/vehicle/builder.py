@@ -60,7 +60,8 @@ class VehicleLayout:
 
 def add_vehicle(scene: Scene, pair, *, speed_ms: float, parameters: VehicleParameters | None = None,
                 creep: str = "linear", friction_coefficient: float = 0.3, drive: str = "constraint",
-                lateral_offset_m: float = 0.0, x_m: float = 0.0, contact_form: str = "railframe") -> VehicleLayout:
+                lateral_offset_m: float = 0.0, x_m: float = 0.0, contact_form: str = "railframe",
+                car_body_load_N: float = 0.0) -> VehicleLayout:
     """Add the vehicle, centred at ``x_m`` on tangent track, moving at ``speed_ms`` (m/s).
 
     Parameters
@@ -86,6 +87,10 @@ def add_vehicle(scene: Scene, pair, *, speed_ms: float, parameters: VehicleParam
         Initial position of the vehicle centre along the track (m).
     contact_form : {"railframe", "global"}
         Form of the contact constraints (seed eq. 22 or 21).
+    car_body_load_N : float
+        Vertical load (N) that other parts of the scene put on the car body (e.g. a pantograph
+        and its contact force); the suspension preloads include it, so the vehicle starts in
+        equilibrium.
     """
     p = parameters or VehicleParameters()
     if drive not in DRIVES:
@@ -94,7 +99,7 @@ def add_vehicle(scene: Scene, pair, *, speed_ms: float, parameters: VehicleParam
         raise ParameterError(f"creep={creep!r}: must be none, linear or polach")
     if not speed_ms > 0:
         raise ParameterError(f"speed_ms={speed_ms!r}: must be > 0 (m/s)")
-    loads = p.static_loads_N()
+    loads = p.static_loads_N(car_body_load_N)
     layout = VehicleLayout(parameters=p)
     v = (speed_ms, 0.0, 0.0)
     y0 = lateral_offset_m

@@ -77,11 +77,13 @@ class VehicleParameters:
                      + 2 * self.wheelset_mass_kg)
         return self.car_body_mass_kg + 2 * per_bogie
 
-    def static_loads_N(self) -> dict:
+    def static_loads_N(self, car_body_load_N: float = 0.0) -> dict:
         """Static vertical load (N) carried by one element of each suspension level, for the
         symmetric vehicle at rest: ``secondary`` (per bogie side), ``equalizer_spring`` (two
-        per equalizer), ``journal`` (per axlebox) and ``wheel`` (per wheel)."""
-        above_bolster = self.car_body_mass_kg / 2
+        per equalizer), ``journal`` (per axlebox) and ``wheel`` (per wheel).
+        ``car_body_load_N``: a further vertical load on the car body, centred (N; e.g. the
+        pantograph)."""
+        above_bolster = (self.car_body_mass_kg + car_body_load_N / G) / 2
         secondary = (above_bolster + self.bolster_mass_kg) * G / 2
         equalizer_spring = (above_bolster + self.bolster_mass_kg + self.frame_mass_kg) * G / 4
         journal = (above_bolster + self.bolster_mass_kg + self.frame_mass_kg + 2 * self.equalizer_mass_kg) * G / 4
