@@ -221,6 +221,10 @@ def main():
     from bench.wheelset import section as wheelset_section
 
     wheelset = wheelset_section(REPORT)
+    print("vehicle ...", flush=True)
+    from bench.vehicle import section as vehicle_section
+
+    vehicle = vehicle_section(REPORT)
     lines = [
         "# symcat benchmark report",
         "",
@@ -282,6 +286,7 @@ def main():
         *pantograph,
         "",
         *wheelset,
+        *vehicle,
     ]
     (REPORT / "README.md").write_text("\n".join(lines))
     print(f"wrote {REPORT / 'README.md'}")
