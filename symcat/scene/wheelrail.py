@@ -86,7 +86,8 @@ class WheelRailJoint:
         Tangent track: gauge and rail inclination (default 1.435 m, as built into the rail
         profile); the cheaper ``wheelrail_*_rigid_ground`` kernels. Curved track: a layout
         (circular curves, clothoid transitions, cant, gradient, irregularities; give it
-        ``rail_offset_m=rail_offset_for(rail)``), the ``wheelrail_*_rigid_track`` kernels.
+        ``rail_offset_m=rail_offset_for(rail)``), the ``wheelrail_*_rigid_track`` kernels (the
+        ends of cant ramps are kinks of the rails: see :mod:`symcat.wheelrail.track_pieces`).
     cant_rad : float
         Cant of a tangent track's cross-section (rad); 0 with a layout (it has its own).
     form : {"railframe", "global"}

@@ -17,6 +17,15 @@ exactly quadratic, so exact), and the orientation is ``A^t = Rz(psi) Ry(-theta) 
 rotation. The rail inclination added by the layout is the kernel's ``roll`` (``side`` times
 :attr:`TrackLayout.inclination_rad`); the origin offset ``(Y_o, Z_o)`` is zero (the layout's
 rail frames already carry the rail offset, the low-rail cant pivot and irregularities).
+
+Smoothness: the pieces are C1 where the layout's rail frames are, so ``C`` and ``C_s`` are
+continuous across piece ends and ``Q_d`` jumps only where the layout's curvature rate does (the
+ends of a clothoid). A change of cant is a linear superelevation ramp, however, whose ends are
+kinks of the rails (the cant rate steps: the raised rail's slope drops by half the ramp's
+gradient, 4 mrad for 80 mm over 10 m) and creases of the rail surfaces; a rigid constraint
+contact crosses them as an impact. With the augmented formulation the driver's contact-jump
+projection (:mod:`symcat.integrate.contact_jumps`) carries the run over; the embedded
+formulation, whose surface parameters are algebraic, stops there (IDAS failure).
 """
 from __future__ import annotations
 

@@ -271,6 +271,38 @@ def test_free_coned_wheelset_curves_at_the_pure_rolling_offset():
     assert res.position_drift.max() < 5e-5  # index-1 drift at rtol 1e-6, as on tangent track
 
 
+def test_crossing_the_end_of_a_cant_ramp():
+    """A linear cant ramp ends with a kink in the rails (the cant rate steps; the raised rail's
+    slope drops by 4 mrad here): the rigid contact crosses it as an impact, which the driver's
+    contact-jump projection carries (augmented formulation); the wheelset follows the cant."""
+    pair = profile_pair("conical", CONICITY)
+    layout = TrackLayout([Tangent(3.0), Transition(10.0), Curve(10.0, 300.0, "right", 0.08)],
+                         rail_offset_m=rail_offset_for(pair.rail))
+    x0 = 11.0
+    placed = wheelset_on_track(pair.wheel, pair.rail, 0.0, x_m=x0, track=layout)
+    axes = layout.track_frame(x0).A[0]
+    cant_rate = float(np.diff(layout.cant_angle([x0 - 1e-4, x0 + 1e-4]))[0] / 2e-4)
+    omega = (placed.rotation[:, 1] * SPEED / 0.46 + SPEED * cant_rate * axes[:, 0]
+             + SPEED * float(layout.curvature(x0)[0]) * np.array([0.0, 0.0, 1.0]))
+    scene = Scene(gravity=(0.0, 0.0, -G))
+    scene.add(RigidBody("ws", MASS, INERTIA, position=placed.position_m, rotation=placed.rotation,
+                        velocity=tuple(SPEED * axes[:, 0]), angular_velocity=tuple(omega)))
+    creep = CreepModel("linear", nominal_normal_force_N=0.5 * MASS * G)
+    for side in ("left", "right"):
+        scene.add(WheelRailJoint(f"wr_{side}", "ws", side, pair.wheel, pair.rail, track=layout, creep=creep))
+    res = simulate(MultibodyModel(scene), 0.8, n_out=40, progress=False)
+    assert res.stats.get("contact_jumps", 0) >= 1
+    s = res.wheelrail["wr_left"]["s"][:, 2]
+    assert s[0] < 13.0 < s[-1]
+    tilt = np.array([math.asin(_rotation(q[3:7])[2, 1]) for q in res.q])  # axle against the horizontal
+    ramp = s < 13.0
+    np.testing.assert_allclose(tilt[ramp], layout.cant_angle(s[ramp]), atol=1e-3)
+    assert abs(tilt[-1] - layout.cant_angle(s[-1])[0]) < 3e-3  # in the curve: the cant plus the rolled offset
+    normal = np.c_[res.wheelrail["wr_left"]["normal_force_N"], res.wheelrail["wr_right"]["normal_force_N"]]
+    assert normal[1:].min() > 0.7 * 0.5 * MASS * G
+    assert res.position_drift[-1] < 5e-5
+
+
 def test_running_off_the_layout_stops_the_run_with_its_chainage():
     pair = profile_pair("conical", CONICITY)
     layout = TrackLayout([Curve(6.0, RADIUS, "left")], rail_offset_m=rail_offset_for(pair.rail))
