@@ -11,10 +11,17 @@ Creep forces (:class:`symcat.scene.CreepModel`) are applied forces at the wheel'
 at the contact; they depend on the normal force, which is the multiplier of the gap row
 (``N = -lambda``: the constraint force on the wheelset is ``-C_q^T lambda`` and the gap row's
 gradient is the rail's outward normal), so :mod:`symcat.dae.formulation` adds them to the
-dynamics with the multipliers. The contact frame is ``t1 = x`` (rolling direction, tangent
-track), ``n`` the rail's outward normal at the contact, ``t2 = n x t1``; the creepages are the
-material point's velocity along ``t1, t2`` and the wheelset's angular velocity along ``n``,
-divided by ``V = sqrt((R_dot . t1)^2 + v_ref^2)``.
+dynamics with the multipliers. The contact frame is ``t1`` the unit rail tangent along the track
+at the contact (rolling direction: global ``x`` on tangent track), ``n`` the rail's outward
+normal there, ``t2 = n x t1``; the creepages are the material point's velocity along ``t1, t2``
+and the wheelset's angular velocity along ``n``, divided by ``V = sqrt((R_dot . t1)^2 +
+v_ref^2)`` (the forward speed along the track tangent).
+
+Curved track (a :class:`symcat.wheelrail.track.TrackLayout` as the joint's ``track``): the
+kernels ``wheelrail_*_rigid_track`` take the cubic track piece holding ``s1r`` as 22 more
+parameters, selected by :meth:`symcat.wheelrail.track_pieces.TrackRailFrames.lookup` (a binary
+search and a table read by symbolic index: zero derivative, cost independent of the track's
+length); tangent track keeps the cheaper ``wheelrail_*_rigid_ground`` kernels.
 """
 from __future__ import annotations
 
@@ -64,6 +71,7 @@ class WheelRailEntry:
     head: np.ndarray                # the 6 constant kernel parameters
     wheel_piece: ca.Function
     rail_piece: ca.Function
+    track_piece: ca.Function | None = None  # curved track: s1r -> track piece (22)
     creep: CreepSetup | None = None
     creep_fn: ca.Function | None = None
     s_index: int = 0                # first of the contact's 4 entries in s
@@ -107,9 +115,11 @@ def add_wheelrail(model, joint: WheelRailJoint) -> WheelRailEntry:
     entry = WheelRailEntry(joint, contact, contact.library, body, rows, s0, head,
                            piece_lookup(joint.wheel, f"{joint.name}_wheel_piece"),
                            piece_lookup(joint.rail, f"{joint.name}_rail_piece"))
+    if contact.curved:
+        entry.track_piece = contact.frames.lookup(f"{joint.name}_track_piece")
     if joint.creep is not None:
         entry.creep = creep_setup(joint, contact, point)
-        entry.creep_fn = creep_function(joint, entry.creep)
+        entry.creep_fn = creep_function(joint, entry.creep, curved=contact.curved)
     return entry
 
 
@@ -145,17 +155,43 @@ def _cubic(s, s0, c):
     return c[0] * d**3 + c[1] * d**2 + c[2] * d + c[3], 3 * c[0] * d**2 + 2 * c[1] * d + c[2]
 
 
-def creep_function(joint: WheelRailJoint, setup: CreepSetup) -> ca.Function:
+def _rail_tangents(p, s, curved: bool):
+    """Rail tangents ``t1^r = dr^r/ds1r`` and ``t2^r = dr^r/ds2r`` (global, SX) at surface
+    parameters ``s`` for kernel parameters ``p``, as the kernels write them."""
+    side, y_o, z_o, roll = p[0], p[3], p[4], p[5]
+    y_r, dy_r = _cubic(s[3], p[15], p[16:20])
+    z_r, dz_r = _cubic(s[3], p[15], p[20:24])
+    c, sn = ca.cos(roll), ca.sin(roll)
+    rx = ca.vertcat(ca.horzcat(1, 0, 0), ca.horzcat(0, c, -sn), ca.horzcat(0, sn, c))
+    u, du = ca.vertcat(0, side * y_r, z_r), ca.vertcat(0, side * dy_r, dz_r)
+    if not curved:
+        return ca.DM([1.0, 0.0, 0.0]), ca.mtimes(rx, du)
+    tp = p[24:46]
+    t = s[2] - tp[0]
+    d_origin = ca.vertcat(*[tp[4 + i] + 2 * tp[7 + i] * t + 3 * tp[10 + i] * t**2 for i in range(3)])
+    psi = tp[13] + t * (tp[14] + t * (tp[15] + t * tp[16]))
+    d_psi = tp[14] + t * (2 * tp[15] + 3 * t * tp[16])
+    phi = tp[17] + t * (tp[18] + t * (tp[19] + t * tp[20]))
+    d_phi = tp[18] + t * (2 * tp[19] + 3 * t * tp[20])
+    cp, sp, ct, st, cf, sf = ca.cos(psi), ca.sin(psi), ca.cos(tp[21]), ca.sin(tp[21]), ca.cos(phi), ca.sin(phi)
+    a0 = ca.vertcat(ca.horzcat(cp * ct, -sp, -cp * st), ca.horzcat(sp * ct, cp, -sp * st), ca.horzcat(st, 0, ct))
+    a_t = ca.mtimes(a0, ca.vertcat(ca.horzcat(1, 0, 0), ca.horzcat(0, cf, -sf), ca.horzcat(0, sf, cf)))
+    kz = ca.DM([[0, -1, 0], [1, 0, 0], [0, 0, 0]])
+    kx = ca.DM([[0, 0, 0], [0, 0, -1], [0, 1, 0]])
+    d_a = d_psi * ca.mtimes(kz, a_t) + d_phi * ca.mtimes(a_t, kx)
+    t1r = d_origin + ca.mtimes(d_a, ca.vertcat(0, y_o, z_o) + ca.mtimes(rx, u))
+    return t1r, ca.mtimes(a_t, ca.mtimes(rx, du))
+
+
+def creep_function(joint: WheelRailJoint, setup: CreepSetup, curved: bool = False) -> ca.Function:
     """SX function ``(x, x_dot, s, p, N) -> (Q, [xi_x, xi_y, phi, Fx, Fy, Mz])``: generalized creep
     forces on the wheelset coordinates ``x = [R, theta]`` (7) for surface parameters ``s``,
-    kernel parameters ``p`` (24) and normal force ``N`` (N)."""
+    kernel parameters ``p`` (24; 46 on curved track) and normal force ``N`` (N)."""
     x, xd = ca.SX.sym("x", 7), ca.SX.sym("xd", 7)
-    s, p, normal = ca.SX.sym("s", 4), ca.SX.sym("p", 24), ca.SX.sym("N")
-    side, r0, b, roll = p[0], p[1], p[2], p[5]
+    s, p, normal = ca.SX.sym("s", 4), ca.SX.sym("p", 46 if curved else 24), ca.SX.sym("N")
+    side, r0, b = p[0], p[1], p[2]
     y_w, _ = _cubic(s[0], p[6], p[7:11])
     z_w, _ = _cubic(s[0], p[6], p[11:15])
-    _, dy_r = _cubic(s[3], p[15], p[16:20])
-    _, dz_r = _cubic(s[3], p[15], p[20:24])
     rho = r0 + z_w
     u_w = ca.vertcat(rho * ca.sin(s[1]), side * (b + y_w), -rho * ca.cos(s[1]))
     th, r_dot, th_dot = x[3:7], xd[:3], xd[3:7]
@@ -164,9 +200,8 @@ def creep_function(joint: WheelRailJoint, setup: CreepSetup) -> ca.Function:
     g = ca.vertcat(ca.horzcat(-e1, e0, -e3, e2), ca.horzcat(-e2, e3, e0, -e1), ca.horzcat(-e3, -e2, e1, e0))
     omega = 2 * ca.mtimes(g, th_dot)
     v_point = r_dot + ca.cross(omega, arm)
-    c, sn = ca.cos(roll), ca.sin(roll)
-    t2r = ca.vertcat(0, c * side * dy_r - sn * dz_r, sn * side * dy_r + c * dz_r)
-    t1 = ca.DM([1.0, 0.0, 0.0])
+    t1r, t2r = _rail_tangents(p, s, curved)
+    t1 = t1r if not curved else t1r / ca.norm_2(t1r)
     n = side * ca.cross(t1, t2r)
     n = n / ca.norm_2(n)
     t2 = ca.cross(n, t1)
@@ -224,8 +259,10 @@ def kernel_inputs(entry: WheelRailEntry, q: ca.MX, v: ca.MX, s: ca.MX, s_dot: ca
     s_e, sd_e = s[i : i + 4], s_dot[i : i + 4]
     y = ca.vertcat(q[entry.rows], s_e)
     y_dot = ca.vertcat(v[entry.rows], sd_e)
-    p = ca.vertcat(ca.DM(entry.head), entry.wheel_piece(s_e[0]), entry.rail_piece(s_e[3]))
-    return y, y_dot, p
+    pieces = [ca.DM(entry.head), entry.wheel_piece(s_e[0]), entry.rail_piece(s_e[3])]
+    if entry.track_piece is not None:
+        pieces.append(entry.track_piece(s_e[2]))
+    return y, y_dot, ca.vertcat(*pieces)
 
 
 def constraint_parts(model, q, v, s, s_dot, t, place):

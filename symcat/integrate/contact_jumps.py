@@ -8,6 +8,10 @@ wheel from scratch; where it lies elsewhere on the profiles and lower (penetrati
 followed one, the surface parameters move there and the state is projected back onto the
 constraints (positions, then velocities: the minimum-norm change, an impact-like velocity jump)
 before IDAS restarts. The rest of the run is the constraint formulation unchanged.
+
+On curved track the search is the same (:meth:`WheelRailContact.solve` projects the wheel onto
+the layout's cross-sections); a contact whose point has left the layout's defined length ends
+the run with a :class:`SolverError` naming it (the kernels would extrapolate the end piece).
 """
 from __future__ import annotations
 
@@ -16,7 +20,7 @@ import math
 import numpy as np
 
 from ..dae.initial import consistent_state
-from ..errors import SolverError
+from ..errors import ParameterError, SolverError
 from .failure import split_state
 
 #: A lowest point this much below the followed one (m) triggers a jump.
@@ -40,6 +44,10 @@ def jump_contacts(form, x, z, t: float):
         q_body = q_full[e.rows]
         i = e.s_index
         current = s[i : i + 4]
+        try:
+            e.contact.frames.check(current[2])
+        except ParameterError as err:
+            raise SolverError(f"wheel/rail contact {e.joint.name!r} at t = {t:.6g} s: {err}") from None
         try:
             lowest = e.contact.solve(q_body)
         except SolverError:

@@ -65,8 +65,11 @@ class WheelRailJoint:
     """One wheel of a rigid wheelset on its rail (constraint contact).
 
     The wheelset body's frame has its origin on the axle centre and the axle along the body
-    ``y`` axis; the track runs along global ``x`` (tangent track) with ``y`` toward the left
-    rail and ``z`` up, the rail tops at ``z = 0`` (see :mod:`symcat.wheelrail.constraint_contact`).
+    ``y`` axis. Tangent track (``track`` a cross-section or ``None``) runs along global ``x``
+    with ``y`` toward the left rail and ``z`` up, the rail tops at ``z = 0``; curved track
+    (``track`` a :class:`symcat.wheelrail.track.TrackLayout`) follows the layout, ``s1r`` being
+    its chainage (see :mod:`symcat.wheelrail.constraint_contact`; place the wheelset with
+    :func:`symcat.wheelrail.wheelset_on_track` and the same ``track``).
 
     Parameters
     ----------
@@ -79,14 +82,20 @@ class WheelRailJoint:
         Profiles (mirrored on the right).
     wheelset : symcat.wheelrail.WheelsetDimensions, optional
         Tape-circle distance and nominal radius (default 1.5 m, 0.46 m).
-    track : symcat.wheelrail.TrackCrossSection, optional
-        Gauge and rail inclination (default 1.435 m, as built into the rail profile).
+    track : symcat.wheelrail.TrackCrossSection or symcat.wheelrail.track.TrackLayout, optional
+        Tangent track: gauge and rail inclination (default 1.435 m, as built into the rail
+        profile); the cheaper ``wheelrail_*_rigid_ground`` kernels. Curved track: a layout
+        (circular curves, clothoid transitions, cant, gradient, irregularities; give it
+        ``rail_offset_m=rail_offset_for(rail)``), the ``wheelrail_*_rigid_track`` kernels (the
+        ends of cant ramps are kinks of the rails: see :mod:`symcat.wheelrail.track_pieces`).
     cant_rad : float
-        Cant of the cross-section (rad).
+        Cant of a tangent track's cross-section (rad); 0 with a layout (it has its own).
     form : {"railframe", "global"}
         Constraint form: eq. 22 (default; needed by the embedded formulation) or eq. 21.
     creep : CreepModel, optional
         Creep forces; none (frictionless) by default.
+    track_piece_length_m : float
+        Longest cubic piece of a curved track's rail frame (m).
     """
 
     name: str
@@ -99,6 +108,7 @@ class WheelRailJoint:
     cant_rad: float = 0.0
     form: str = "railframe"
     creep: CreepModel | None = field(default=None)
+    track_piece_length_m: float = 1.0
 
     def __post_init__(self):
         if self.side not in ("left", "right"):
@@ -116,4 +126,4 @@ class WheelRailJoint:
         from ..wheelrail.constraint_contact import WheelRailContact
 
         return WheelRailContact(self.wheel, self.rail, self.side, wheelset=self.wheelset, track=self.track,
-                                cant_rad=self.cant_rad, form=self.form)
+                                cant_rad=self.cant_rad, form=self.form, track_piece_length_m=self.track_piece_length_m)

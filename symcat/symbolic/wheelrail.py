@@ -30,9 +30,27 @@ the rotation of the profile plane about the track axis (cant plus ``side`` times
 inclination not built into the profile data). The profile's ``y`` is mirrored on the right
 (``side`` = -1), so ``u_bar^rp`` keeps ``A^rp`` a rotation; the outward normal is therefore
 ``n^r = side t1^r x t2^r`` (eq. 18 up to that sign). Tangents (eq. 17) are derived from
-``r^r`` itself, so a curved-track frame only has to replace :func:`tangent_track_frame`
-(hook: ``R^rp, A^rp`` as local cubic pieces in ``s1r`` from :mod:`symcat.wheelrail.track`,
-their coefficients added to the parameters the same way as the profiles').
+``r^r`` itself, so the track geometry enters only through the frame ``(R^rp, A^rp)``.
+
+Curved track (libraries ``wheelrail_{global,railframe}_rigid_track``): the frame is one cubic
+piece in ``s1r`` of a rail frame along the track (built by :mod:`symcat.wheelrail.track_pieces`
+from a :class:`symcat.wheelrail.track.TrackLayout`: tangents, circular curves, clothoid
+transitions, cant, gradient, rail inclination, irregularities), as the layout writes it
+(``A = Rz(psi) Ry(-theta) Rx(phi)``): an origin cubic ``R^t``, heading ``psi`` and cant angle
+``phi`` cubics and the constant gradient angle ``theta``, with the origin offset and roll of the
+profile applied in that frame::
+
+    t = s1r - st0,   R^t = sum_k tR_k t**k,   psi = sum_k psi_k t**k,   phi = sum_k phi_k t**k
+    A^t = Rz(psi) Ry(-theta) Rx(phi)
+    R^rp = R^t + A^t [0, Y_o, Z_o],   A^rp = A^t R_x(roll)
+
+``A^t`` is a rotation whatever the coefficients; pieces ``R^t = [s1r, 0, 0]``, ``psi = phi =
+theta = 0`` give the tangent-track kernel. ``s1r`` is the layout's chainage (distance along the
+centreline in plan), not the rail's arc length: ``t1^r`` is not a unit vector (``1 - kappa y``
+in a curve) and, where the cant changes, not normal to ``t2^r``. The rail-frame rows of the track
+libraries are therefore written as the components of ``d`` along the unit vectors
+``t1^r/|t1^r|, t2^r/|t2^r|, n^r`` in global components: the rows below, since ``A^rp`` is a
+rotation.
 
 Constraints (5 each; all unit vectors, so the multiplier of the normal row is the normal
 force in N and the others vanish at a frictionless equilibrium)::
@@ -48,7 +66,10 @@ equivalent at the solution). ``n^r . d`` is the normal gap (m, positive when sep
 paper prints eq. 22 with four rows, the fifth (``t2w . n^r``) is restored here.
 
 Parameters (in this order; see :data:`PARAM_DOC`): ``side, r0, b, Y_o, Z_o, roll``, then the
-wheel piece ``sw0, wy_0:4, wz_0:4`` and the rail piece ``sr0, ry_0:4, rz_0:4``.
+wheel piece ``sw0, wy_0:4, wz_0:4`` and the rail piece ``sr0, ry_0:4, rz_0:4`` (24); the track
+libraries append the track piece ``st0, tR0_0 .. tR3_2, psi_0:4, phi_0:4, theta`` (22,
+:data:`TRACK_PARAM_DOC`; ``Y_o, Z_o`` are then components in the piece frame, ``roll`` about its
+first axis).
 """
 from __future__ import annotations
 
@@ -72,9 +93,25 @@ PARAM_DOC = (
     *((f"rz_{k}", f"m^{-2 + k}", f"rail z coefficient of (s2r - sr0)^{3 - k}") for k in range(4)),
 )
 PARAM_NAMES = tuple(name for name, _, _ in PARAM_DOC)
+#: Track piece of the curved-track libraries (appended to :data:`PARAM_DOC`): start, the
+#: ascending-power coefficients of the frame origin (component ``i``), of the heading and of the
+#: cant angle, and the gradient angle.
+TRACK_PARAM_DOC = (
+    ("st0", "m", "start chainage of the track piece"),
+    *((f"tR{k}_{i}", f"m^{1 - k}", f"frame origin component {i}, coefficient of (s1r - st0)^{k}")
+      for k in range(4) for i in range(3)),
+    *((f"psi_{k}", f"rad/m^{k}", f"heading, coefficient of (s1r - st0)^{k}") for k in range(4)),
+    *((f"phi_{k}", f"rad/m^{k}", f"cant angle, coefficient of (s1r - st0)^{k}") for k in range(4)),
+    ("theta", "rad", "gradient angle (rise of the track axis)"),
+)
+TRACK_PARAM_NAMES = tuple(name for name, _, _ in TRACK_PARAM_DOC)
+N_TANGENT_PARAMS = len(PARAM_NAMES)
+N_TRACK_PARAMS = len(PARAM_NAMES) + len(TRACK_PARAM_NAMES)
 #: Surface parameters, in the order of eq. (15).
 SURFACE_PARAMETERS = ("s1w", "s2w", "s1r", "s2r")
 FORMS = ("global", "railframe")
+#: Track kinds: ``"ground"`` (tangent track along global x) and ``"track"`` (cubic track pieces).
+TRACKS = ("ground", "track")
 
 
 def _cubic(s, s0, coeffs):
@@ -96,18 +133,47 @@ def tangent_track_frame(s1r, par: dict) -> tuple[sp.Matrix, sp.Matrix]:
     return sp.Matrix([s1r, par["Y_o"], par["Z_o"]]), _rot_x(par["roll"])
 
 
-def wheelrail(form: str) -> ConstraintDefinition:
+def _ascending(t, coeffs):
+    return ((coeffs[3] * t + coeffs[2]) * t + coeffs[1]) * t + coeffs[0]
+
+
+def _rot_y(a) -> sp.Matrix:
+    c, s = sp.cos(a), sp.sin(a)
+    return sp.Matrix([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+def _rot_z(a) -> sp.Matrix:
+    c, s = sp.cos(a), sp.sin(a)
+    return sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def piece_track_frame(s1r, par: dict) -> tuple[sp.Matrix, sp.Matrix]:
+    """Rail profile frame ``(R^rp, A^rp)`` on one cubic track piece (module docstring)."""
+    t = s1r - par["st0"]
+    r_t = sp.Matrix([_ascending(t, [par[f"tR{k}_{i}"] for k in range(4)]) for i in range(3)])
+    psi = _ascending(t, [par[f"psi_{k}"] for k in range(4)])
+    phi = _ascending(t, [par[f"phi_{k}"] for k in range(4)])
+    a_t = _rot_z(psi) * _rot_y(-par["theta"]) * _rot_x(phi)
+    return r_t + a_t * sp.Matrix([0, par["Y_o"], par["Z_o"]]), a_t * _rot_x(par["roll"])
+
+
+def wheelrail(form: str, track: str = "ground") -> ConstraintDefinition:
     """Five contact constraints of one wheel of a rigid wheelset on a ground-fixed rail.
 
-    ``form`` is ``"global"`` (eq. 21) or ``"railframe"`` (eq. 22); ``y = [R, theta, s1w, s2w,
-    s1r, s2r]`` (11), parameters :data:`PARAM_NAMES`.
+    ``form`` is ``"global"`` (eq. 21) or ``"railframe"`` (eq. 22); ``track`` is ``"ground"``
+    (tangent track along global ``x``, parameters :data:`PARAM_NAMES`) or ``"track"`` (one cubic
+    track piece, parameters :data:`PARAM_NAMES` + :data:`TRACK_PARAM_NAMES`); ``y = [R, theta,
+    s1w, s2w, s1r, s2r]`` (11).
     """
     if form not in FORMS:
         raise ValueError(f"form={form!r}: must be one of {', '.join(FORMS)}")
+    if track not in TRACKS:
+        raise ValueError(f"track={track!r}: must be one of {', '.join(TRACKS)}")
     wheelset = _Side("rigid", "i")
     t = sp.Symbol("t", real=True)
     s1w, s2w, s1r, s2r = s = sp.symbols(" ".join(SURFACE_PARAMETERS), real=True)
-    par = {n: sp.Symbol(n, real=True) for n in PARAM_NAMES}
+    names = PARAM_NAMES + (TRACK_PARAM_NAMES if track == "track" else ())
+    par = {n: sp.Symbol(n, real=True) for n in names}
     side, r0, b = par["side"], par["r0"], par["b"]
 
     # Wheel (eq. 20): surface of revolution of the profile piece about the body y axis.
@@ -124,7 +190,8 @@ def wheelrail(form: str) -> ConstraintDefinition:
     # Rail (eq. 19 with the rail fixed to the ground).
     y_r = _cubic(s2r, par["sr0"], [par[f"ry_{k}"] for k in range(4)])
     z_r = _cubic(s2r, par["sr0"], [par[f"rz_{k}"] for k in range(4)])
-    r_rp, a_rp = tangent_track_frame(s1r, par)
+    frame = tangent_track_frame if track == "ground" else piece_track_frame
+    r_rp, a_rp = frame(s1r, par)
     r_r = r_rp + a_rp * sp.Matrix([0, side * y_r, z_r])
     t1r, t2r = r_r.diff(s1r), r_r.diff(s2r)
     n_r = _unit(side * t1r.cross(t2r))
@@ -134,18 +201,30 @@ def wheelrail(form: str) -> ConstraintDefinition:
     if form == "global":
         c = sp.Matrix.vstack(d, tangency)
         description = "wheel/rail contact, global form (seed eq. 21)"
-    else:
+    elif track == "ground":
         # In the profile frame: d_bar = A^rp^T d against the local unit vectors of the rail.
         d_bar = a_rp.T * d
-        frame = [_unit(a_rp.T * t1r), _unit(a_rp.T * t2r), a_rp.T * n_r]
-        c = sp.Matrix.vstack(sp.Matrix([v.dot(d_bar) for v in frame]), tangency)
+        local = [_unit(a_rp.T * t1r), _unit(a_rp.T * t2r), a_rp.T * n_r]
+        c = sp.Matrix.vstack(sp.Matrix([v.dot(d_bar) for v in local]), tangency)
         description = "wheel/rail contact, rail-frame form (seed eq. 22)"
-    p = [par[n] for n in PARAM_NAMES]
+    else:
+        # The same components of d, taken in global components (A^t is a cubic, not a rotation).
+        c = sp.Matrix.vstack(sp.Matrix([_unit(t1r).dot(d), _unit(t2r).dot(d), n_r.dot(d)]), tangency)
+        description = "wheel/rail contact, rail-frame form (seed eq. 22)"
+    if track == "track":
+        description += ", curved track (cubic track pieces)"
+    p = [par[n] for n in names]
     return ConstraintDefinition(
-        name=f"wheelrail_{form}_rigid_ground", x_i=wheelset.x, x_j=sp.zeros(0, 1), s=sp.Matrix(s), t=t,
-        p=sp.Matrix(p), param_names=list(PARAM_NAMES), c=c, description=description,
+        name=library_name(form, track), x_i=wheelset.x, x_j=sp.zeros(0, 1), s=sp.Matrix(s), t=t,
+        p=sp.Matrix(p), param_names=list(names), c=c, description=description,
     )
 
 
+def library_name(form: str, track: str = "ground") -> str:
+    """Name of the kernel library of a constraint form and track kind."""
+    return f"wheelrail_{form}_rigid_{track}"
+
+
 #: Wheel/rail constraint libraries: name -> builder (kept apart from the joints' registry).
-WHEELRAIL_CONSTRAINTS = {f"wheelrail_{form}_rigid_ground": (lambda form=form: wheelrail(form)) for form in FORMS}
+WHEELRAIL_CONSTRAINTS = {library_name(form, track): (lambda form=form, track=track: wheelrail(form, track))
+                         for track in TRACKS for form in FORMS}

@@ -7,7 +7,9 @@ equivalent conicity (EN 15302). NumPy/SciPy only.
   analytic coned and circular-arc profiles, converted to one frame;
 * :mod:`.geometry` - contact points, rolling radii and contact angles against lateral shift
   (the search itself in :mod:`.gap_search`);
-* :mod:`.conicity` - equivalent conicity from the rolling radius difference.
+* :mod:`.conicity` - equivalent conicity from the rolling radius difference;
+* :mod:`.track` - track layouts (curves, clothoids, cant) and rail frames; :mod:`.track_pieces`
+  their cubic pieces for the constraint contact (:mod:`.constraint_contact`, :mod:`.placement`).
 """
 from .conicity import equivalent_conicity
 from .geometry import ContactGeometry, TrackCrossSection, WheelsetDimensions, contact_geometry, gauge_point

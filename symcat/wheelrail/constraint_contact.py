@@ -1,23 +1,26 @@
 """Constraint contact of one wheel of a rigid wheelset on its rail (seed eqs. 15-22), at run time.
 
-The compiled kernels ``wheelrail_global_rigid_ground`` (eq. 21) and
-``wheelrail_railframe_rigid_ground`` (eq. 22) are exact on one cubic piece of each profile (see
+The compiled kernels ``wheelrail_global_rigid_*`` (eq. 21) and ``wheelrail_railframe_rigid_*``
+(eq. 22) are exact on one cubic piece of each profile (and of the track; see
 :mod:`symcat.symbolic.wheelrail` for the surfaces, frames and parameter layout). This module
 picks the pieces that contain the current surface parameters, passes their coefficients and
 evaluates ``C``, ``C_q``, ``C_s``, ``C_t`` and ``Q_d``; and it locates the contact point of a
 given wheelset position (the geometric solve of the embedded formulation) by Newton's method.
 
-Frames (as :mod:`.geometry`, extended to 3D): global ``x`` along the track, ``y`` toward the
-left rail, ``z`` up, origin on the track centre line at rail-top level. Wheelset coordinates
+Frames (as :mod:`.geometry`, extended to 3D): on tangent track global ``x`` along the track,
+``y`` toward the left rail, ``z`` up, origin on the track centre line at rail-top level; on a
+layout its global frame (:mod:`.track`). Wheelset coordinates
 ``q = [R, theta]``: ``R`` the axle centre (m), ``theta`` Euler parameters, axle along the body
 ``y`` axis. Surface parameters ``s = [s1w, s2w, s1r, s2r]``: wheel profile parameter (m), angle
 about the axle from the bottom of the wheel (rad, positive toward body ``+x``), distance along
-the track (m), rail profile parameter (m).
+the track (m; a layout's chainage), rail profile parameter (m).
 
-Only tangent track for now: the rail profile frame is ``R^rp = [s1r, Y_o, Z_o]``,
-``A^rp = R_x(cant + side * (inclination - built-in inclination))``; a curved track would pass
-its local frame pieces the same way as the profiles' (hook in
-:func:`symcat.symbolic.wheelrail.tangent_track_frame`).
+Tangent track (a :class:`.geometry.TrackCrossSection`, libraries ``*_rigid_ground``): the rail
+profile frame is ``R^rp = [s1r, Y_o, Z_o]``, ``A^rp = R_x(cant + side * (inclination - built-in
+inclination))``. Curved track (a :class:`.track.TrackLayout`, libraries ``*_rigid_track``):
+``s1r`` is the layout's chainage and the frame is the cubic track piece holding it
+(:mod:`.track_pieces`), passed to the kernel like the profile pieces; ``s1r`` must stay on the
+layout (0 to its length).
 """
 from __future__ import annotations
 
@@ -28,21 +31,23 @@ import numpy as np
 
 from symcat.errors import ParameterError, SolverError
 
-from .geometry import TrackCrossSection, WheelsetDimensions, gauge_point
+from .geometry import TrackCrossSection, WheelsetDimensions
 from .profiles import Profile
+from .track_pieces import rail_frames
 
 SIDES = {"left": 1.0, "right": -1.0}
 FORMS = ("global", "railframe")
-N_PARAMS = 24
+N_PARAMS = 24  # tangent track; curved track adds the 22 parameters of a track piece
 #: Largest Newton step per surface parameter: s1w, s2w, s1r, s2r [m, rad, m, m].
 MAX_STEP = np.array([2e-3, 0.02, 5e-3, 2e-3])
 
 
-def library_name(form: str) -> str:
-    """Kernel library of a constraint form (``"global"``: eq. 21, ``"railframe"``: eq. 22)."""
+def library_name(form: str, track: str = "ground") -> str:
+    """Kernel library of a constraint form (``"global"``: eq. 21, ``"railframe"``: eq. 22) on
+    tangent (``track="ground"``) or curved track (``"track"``)."""
     if form not in FORMS:
         raise ParameterError(f"form={form!r}: must be one of {', '.join(FORMS)}")
-    return f"wheelrail_{form}_rigid_ground"
+    return f"wheelrail_{form}_rigid_{track}"
 
 
 @dataclass
@@ -114,13 +119,8 @@ def _np(x) -> np.ndarray:
     return np.asarray(x.full() if hasattr(x, "full") else x, float)
 
 
-def _rot_x(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
 class WheelRailContact:
-    """One wheel/rail contact of a rigid wheelset on tangent track (constraint formulation).
+    """One wheel/rail contact of a rigid wheelset on tangent or curved track (constraint formulation).
 
     Parameters
     ----------
@@ -128,22 +128,32 @@ class WheelRailContact:
         Wheel and rail profiles in the frames of :mod:`.profiles` (the same profiles serve either
         side: they are mirrored on the right, as in :mod:`.geometry`).
     side : str
-        ``"left"`` (wheel on the body ``+y`` end of the axle, rail at global ``y > 0``) or
+        ``"left"`` (wheel on the body ``+y`` end of the axle, rail to the left of the track) or
         ``"right"``.
     wheelset : WheelsetDimensions, optional
         Tape-circle distance and nominal rolling radius (default 1.5 m, 0.46 m).
-    track : TrackCrossSection, optional
-        Gauge, gauge depth and rail inclination (default 1.435 m, 14 mm, as built into the rail
-        profile); the rails are placed exactly as by :func:`.geometry.contact_geometry`.
+    track : TrackCrossSection or TrackLayout, optional
+        Tangent track along global ``x``: gauge, gauge depth and rail inclination (default 1.435 m,
+        14 mm, as built into the rail profile; the rails are placed exactly as by
+        :func:`.geometry.contact_geometry`). Curved track: a :class:`.track.TrackLayout`, whose
+        rail frames (rail offset, inclination, cant, irregularities) place the rail; give it
+        ``rail_offset_m=rail_offset_for(rail)`` for this rail profile's gauge.
     cant_rad : float
-        Cant: rotation of the whole cross-section about the track centre line [rad], positive
-        raising the left rail.
+        Cant of tangent track: rotation of the whole cross-section about the track centre line
+        [rad], positive raising the left rail (a layout has its own cant: must be 0 then).
     form : str
         ``"railframe"`` (eq. 22, default) or ``"global"`` (eq. 21).
+    track_piece_length_m : float
+        Longest cubic track piece on curved track [m].
+
+    Raises
+    ------
+    ParameterError
+        For a bad side, form, profile, dimension, cant or track.
     """
 
     def __init__(self, wheel: Profile, rail: Profile, side: str, *, wheelset: WheelsetDimensions | None = None,
-                 track: TrackCrossSection | None = None, cant_rad: float = 0.0, form: str = "railframe"):
+                 track=None, cant_rad: float = 0.0, form: str = "railframe", track_piece_length_m: float = 1.0):
         if side not in SIDES:
             raise ParameterError(f"side={side!r}: must be 'left' or 'right'")
         for prof, kind in ((wheel, "wheel"), (rail, "rail")):
@@ -152,28 +162,27 @@ class WheelRailContact:
         if not (isinstance(cant_rad, (int, float)) and abs(cant_rad) < 0.3):
             raise ParameterError(f"cant_rad={cant_rad!r}: must be a number with |cant_rad| < 0.3 rad")
         self.wheelset = wheelset or WheelsetDimensions()
-        self.track = track or TrackCrossSection()
-        for label, value in (("tape_circle_distance_m", self.wheelset.tape_circle_distance_m),
-                             ("nominal_radius_m", self.wheelset.nominal_radius_m), ("gauge_m", self.track.gauge_m)):
+        checks = [("tape_circle_distance_m", self.wheelset.tape_circle_distance_m),
+                  ("nominal_radius_m", self.wheelset.nominal_radius_m)]
+        if track is None or isinstance(track, TrackCrossSection):
+            checks.append(("gauge_m", (track or TrackCrossSection()).gauge_m))
+        for label, value in checks:
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ParameterError(f"{label}={value!r}: must be a number > 0")
-        self.form = form
-        self.library = library_name(form)
         self.side = side
         self.sign = SIDES[side]
         self.wheel, self.rail = wheel, rail
         self.cant_rad = float(cant_rad)
-        incl = self.track.rail_inclination_rad
-        extra = 0.0 if incl is None else incl - rail.inclination_rad
-        installed = rail.transformed(extra) if extra else rail
-        origin = 0.5 * self.track.gauge_m - gauge_point(installed, self.track.gauge_depth_m)[0]
-        self.rail_origin_m = _rot_x(self.cant_rad) @ np.array([0.0, self.sign * origin, 0.0])
-        self.profile_roll_rad = self.sign * extra  # relative to the track plane
-        self._roll = self.cant_rad + self.profile_roll_rad
+        #: The rail frames: :class:`.track_pieces.TangentRailFrames` or ``TrackRailFrames``.
+        self.frames = rail_frames(rail, side, track, self.cant_rad, track_piece_length_m)
+        self.track = track if track is not None else TrackCrossSection()
+        self.curved = self.frames.kind == "track"
+        self.form = form
+        self.library = library_name(form, self.frames.kind)
         self._wpp = wheel.piecewise_polynomial()
         self._rpp = rail.piecewise_polynomial()
-        self._head = np.array([self.sign, self.wheelset.nominal_radius_m, 0.5 * self.wheelset.tape_circle_distance_m,
-                               self.rail_origin_m[1], self.rail_origin_m[2], self._roll])
+        self._head = np.r_[self.sign, self.wheelset.nominal_radius_m, 0.5 * self.wheelset.tape_circle_distance_m,
+                           self.frames.head]
         self._kernels = None
 
     # ------------------------------------------------------------------ kernels
@@ -194,8 +203,15 @@ class WheelRailContact:
         return int(np.clip(np.searchsorted(x, s, side="right") - 1, 0, len(x) - 2))
 
     def parameters(self, s, *, pieces: tuple[int, int] | None = None, clip: bool = False) -> np.ndarray:
-        """Kernel parameters (24) for surface parameters ``s``: the spline pieces containing
-        ``s1w`` and ``s2r`` (or the given ``pieces = (wheel, rail)`` indices)."""
+        """Kernel parameters (24, curved track 46) for surface parameters ``s``: the spline pieces
+        containing ``s1w`` and ``s2r`` (or the given ``pieces = (wheel, rail)`` indices) and the
+        track piece containing ``s1r``.
+
+        Raises
+        ------
+        ParameterError
+            If a parameter leaves its profile or the track (unless ``clip``: end pieces extend them).
+        """
         s = np.asarray(s, float)
         if pieces is None:
             iw = self._piece(self._wpp, s[0], "s1w", self.wheel, clip)
@@ -203,7 +219,8 @@ class WheelRailContact:
         else:
             iw, ir = pieces
         cw, cr = self._wpp.c[:, iw, :], self._rpp.c[:, ir, :]
-        return np.r_[self._head, self._wpp.x[iw], cw[:, 0], cw[:, 1], self._rpp.x[ir], cr[:, 0], cr[:, 1]]
+        return np.r_[self._head, self._wpp.x[iw], cw[:, 0], cw[:, 1], self._rpp.x[ir], cr[:, 0], cr[:, 1],
+                     self.frames.params(s[2], clip)]
 
     def residual(self, q, s, t: float = 0.0, **kw) -> np.ndarray:
         """The five constraints ``C(q, s)``."""
@@ -239,50 +256,56 @@ class WheelRailContact:
     def initial_guess(self, q, grid_m: float = 5e-4) -> np.ndarray:
         """Surface parameters near the contact for small yaw: the cross-section approach of
         :mod:`.gap_search` in 3D. Each circle of the wheel (a ``s1w`` of a grid) contributes its
-        lowest point (``s2w`` where the circle's tangent is horizontal), and the one with the
-        smallest gap above the rail (measured along the rail profile's ``z``) is refined on
-        finer grids to about 10 um.
+        lowest point (``s2w`` where the circle's tangent is normal to the ``up`` direction of the
+        track at the axle: global ``z`` on tangent track, the running-plane normal on curved
+        track), and the one with the smallest gap above the rail (measured along the rail
+        profile's ``z`` in the cross-section through the point) is refined on finer grids to
+        about 10 um.
 
         Raises
         ------
         SolverError
             If no wheel circle lies above the rail (wheelset off the rail).
+        ParameterError
+            If the axle centre lies off a curved track's defined length.
         """
         q = np.asarray(q, float)
         a = _rotation(q[3:7])
-        s2w = math.atan2(-a[2, 0], a[2, 2])  # lowest point of every circle (no dependence on s1w)
+        s_axle = self.frames.project(q[None, :3])
+        self.frames.check(s_axle)
+        w = a.T @ self.frames.up(s_axle)
+        s2w = math.atan2(-w[0], w[2])  # lowest point of every circle (no dependence on s1w)
         lo, hi = self.wheel.s_min, self.wheel.s_max
         n = max(int(math.ceil((hi - lo) / grid_m)), 8) + 1
         grid = np.linspace(lo, hi, n)
         best = None
         for _ in range(4):
-            gap, s2r = self._vertical_gap(q, a, s2w, grid)
+            gap, s2r, s1r = self._vertical_gap(q, a, s2w, grid, s_axle)
             if not np.isfinite(gap).any():
                 raise SolverError(f"{self.side} wheel: no point of the wheel lies above the rail at "
                                   f"q={np.array2string(q, precision=5)} (wheelset off the rail)")
             j = int(np.nanargmin(gap))
-            best = (grid[j], s2r[j])
+            best = (grid[j], s2r[j], s1r[j])
             h = grid[1] - grid[0]
             grid = np.linspace(max(grid[j] - h, lo), min(grid[j] + h, hi), 9)
-        pw = self.wheel.position(best[0])
-        rho = self._head[1] + pw[1]
-        point = q[:3] + a @ np.array([rho * math.sin(s2w), self.sign * (self._head[2] + pw[0]), -rho * math.cos(s2w)])
-        return np.array([best[0], s2w, point[0], best[1]])
+        return np.array([best[0], s2w, best[2], best[1]])
 
-    def _vertical_gap(self, q, a, s2w, s1w):
+    def _vertical_gap(self, q, a, s2w, s1w, s_guess):
+        """Gap along the rail profile's ``z`` of the wheel points ``(s1w, s2w)``, the rail
+        parameter below each, and the chainage of its cross-section."""
         pw = self.wheel.position(s1w)
         rho = self._head[1] + pw[:, 1]
         u = np.stack([rho * math.sin(s2w), self.sign * (self._head[2] + pw[:, 0]), -rho * math.cos(s2w)])
-        points = q[:3, None] + a @ u
-        rel = points - np.array([points[0], np.full(len(s1w), self.rail_origin_m[1]),
-                                 np.full(len(s1w), self.rail_origin_m[2])])
-        local = _rot_x(-self._roll) @ rel
+        points = (q[:3, None] + a @ u).T
+        s1r = self.frames.project(points, s_guess)
+        R, A, _, _ = self.frames.frames(s1r)
+        local = np.einsum("nji,nj->in", A, points - R)  # A^T (p - R) in the profile frame
         y_r = self.sign * local[1]
         s2r = self.rail.s_at(y_r)
         z_r = np.full(len(s1w), np.nan)
         ok = np.isfinite(s2r)
         z_r[ok] = self.rail.position(s2r[ok])[:, 1]
-        return local[2] - z_r, s2r
+        return local[2] - z_r, s2r, s1r
 
     def solve(self, q, s_guess=None, *, tol: float = 1e-13, max_iter: int = 40) -> ContactPoint:
         """Contact point of the wheelset at ``q``: the four surface parameters from the two
@@ -375,15 +398,15 @@ class WheelRailContact:
     def _describe(self, s, gap, res, iterations) -> ContactPoint:
         pw = self.wheel.position(s[0])
         pr, dr = self.rail.position(s[3]), self.rail.derivative(s[3])
-        a_rp = _rot_x(self._roll)
-        n_bar = np.array([0.0, -self.sign * dr[1], dr[0]]) / math.hypot(*dr)
-        normal = a_rp @ n_bar
-        in_track = _rot_x(-self.cant_rad) @ normal
-        point = np.array([s[2], *self.rail_origin_m[1:]]) + a_rp @ np.array([0.0, self.sign * pr[0], pr[1]])
+        R, A, dR, dA = (v[0] for v in self.frames.frames(s[2]))
+        u, du = np.array([0.0, self.sign * pr[0], pr[1]]), np.array([0.0, self.sign * dr[0], dr[1]])
+        normal = self.sign * np.cross(dR + dA @ u, A @ du)
+        normal /= np.linalg.norm(normal)
+        in_track = self.frames.track_axes(s[2]).T @ normal
         return ContactPoint(
             s=np.array(s, float), gap_m=float(gap), rolling_radius_m=float(self._head[1] + pw[1]),
             contact_angle_rad=float(math.atan2(-self.sign * in_track[1], in_track[2])),
-            wheel_y_m=float(pw[0]), rail_y_m=float(pr[0]), point_m=point, normal=normal, residual=res,
+            wheel_y_m=float(pw[0]), rail_y_m=float(pr[0]), point_m=R + A @ u, normal=normal, residual=res,
             iterations=iterations,
         )
 

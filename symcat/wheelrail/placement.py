@@ -1,5 +1,6 @@
 """Place a wheelset on the track: both wheels touching their rails (the initial state of a
-multibody run with :class:`symcat.scene.WheelRailJoint` contacts)."""
+multibody run with :class:`symcat.scene.WheelRailJoint` contacts), on tangent track or at a
+chainage of a curved track layout."""
 from __future__ import annotations
 
 import math
@@ -11,6 +12,8 @@ from symcat.errors import ParameterError, SolverError
 
 from .constraint_contact import ContactPoint, WheelRailContact
 from .geometry import TrackCrossSection, WheelsetDimensions, contact_geometry
+from .track import TrackLayout
+from .track_pieces import cross_section_of
 
 
 @dataclass
@@ -47,48 +50,62 @@ def _rot_z(a):
 
 
 def wheelset_on_track(wheel, rail, lateral_shift_m: float = 0.0, *, x_m: float = 0.0, yaw_rad: float = 0.0,
-                      wheelset: WheelsetDimensions | None = None, track: TrackCrossSection | None = None,
-                      cant_rad: float = 0.0, tol_m: float = 1e-12) -> WheelsetPlacement:
+                      wheelset: WheelsetDimensions | None = None, track=None, cant_rad: float = 0.0,
+                      tol_m: float = 1e-12, track_piece_length_m: float = 1.0) -> WheelsetPlacement:
     """The height and roll angle at which both wheels of a wheelset touch their rails.
 
     The 2D contact geometry (:func:`symcat.wheelrail.contact_geometry` with roll) gives the
     start; Newton's method on the two normal gaps of the 3D constraint contact
     (:class:`WheelRailContact`) in height and roll finishes, so the result is consistent with
-    the kernels to ``tol_m``.
+    the kernels to ``tol_m``. The wheelset is placed in the (canted) track frame at ``x_m``: its
+    axle centre at ``lateral_shift_m`` and the height found, its axes those of the track frame
+    turned by the roll found and by ``yaw_rad`` (so on a curve it stands radially for zero yaw).
 
     Parameters
     ----------
     wheel, rail : Profile
     lateral_shift_m : float
-        Lateral displacement of the axle centre toward the left rail (m).
+        Lateral displacement of the axle centre toward the left rail, in the track frame (m).
     x_m : float
-        Position along the track (m).
+        Position along the track (m): global ``x`` on tangent track, the chainage on a layout.
     yaw_rad : float
-        Yaw angle (rad), |yaw| < 0.1.
-    wheelset, track, cant_rad
-        As for :class:`WheelRailContact`.
+        Yaw angle relative to the track tangent (rad), |yaw| < 0.1.
+    wheelset, track, cant_rad, track_piece_length_m
+        As for :class:`WheelRailContact` (``track`` a :class:`TrackCrossSection`, ``None`` or a
+        :class:`.track.TrackLayout`).
+    tol_m : float
+        Largest gap left (m).
 
     Raises
     ------
     ParameterError
-        If the wheelset does not fit on the rails at that shift (names the shift).
+        If the wheelset does not fit on the rails at that shift (names the shift), or ``x_m``
+        lies off the layout.
     """
     if not (isinstance(yaw_rad, (int, float)) and abs(yaw_rad) < 0.1):
         raise ParameterError(f"yaw_rad={yaw_rad!r}: must be a number with |yaw_rad| < 0.1 rad")
     if not (isinstance(lateral_shift_m, (int, float)) and abs(lateral_shift_m) < 0.05):
         raise ParameterError(f"lateral_shift_m={lateral_shift_m!r}: must be a number with |shift| < 0.05 m")
     wheelset = wheelset or WheelsetDimensions()
-    track = track or TrackCrossSection()
-    geo = contact_geometry(wheel, rail, [lateral_shift_m], track=track, wheelset=wheelset, roll=True)
-    contacts = {side: WheelRailContact(wheel, rail, side, wheelset=wheelset, track=track, cant_rad=cant_rad)
+    if isinstance(track, TrackLayout):
+        if not (isinstance(x_m, (int, float)) and 0.0 <= x_m <= track.length_m):
+            raise ParameterError(f"x_m={x_m!r}: must lie on the track layout, 0 <= x_m <= {track.length_m:g} m")
+        frame = track.track_frame(x_m)
+        centre, axes = frame.R[0], frame.A[0]
+        cross = cross_section_of(track, rail)
+    else:
+        cross = track or TrackCrossSection()
+        centre, axes = np.array([float(x_m), 0.0, 0.0]), _rot_x(cant_rad)
+    geo = contact_geometry(wheel, rail, [lateral_shift_m], track=cross, wheelset=wheelset, roll=True)
+    contacts = {side: WheelRailContact(wheel, rail, side, wheelset=wheelset, track=track, cant_rad=cant_rad,
+                                       track_piece_length_m=track_piece_length_m)
                 for side in ("left", "right")}
     x = np.array([float(geo.axle_height_m[0]), float(geo.roll_angle_rad[0])])
     guesses = {}
 
     def state(x):
-        rot = _rot_x(cant_rad + x[1]) @ _rot_z(yaw_rad)
-        lateral = _rot_x(cant_rad) @ np.array([0.0, lateral_shift_m, x[0]])
-        return np.r_[x_m + lateral[0], lateral[1], lateral[2]], rot
+        rot = axes @ _rot_x(x[1]) @ _rot_z(yaw_rad)
+        return centre + axes @ np.array([0.0, lateral_shift_m, x[0]]), rot
 
     def gaps(x):
         from symcat.scene.rigid import euler_parameters
