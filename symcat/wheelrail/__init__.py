@@ -15,6 +15,7 @@ from .conicity import equivalent_conicity
 from .geometry import ContactGeometry, TrackCrossSection, WheelsetDimensions, contact_geometry, gauge_point
 from .placement import WheelsetPlacement, wheelset_on_track
 from .profiles import Profile, validate_points
+from .stability import CriticalSpeed, SuspendedWheelset, critical_speed
 from .standard_profiles import (
     PAIR_NAMES,
     PROFILE_NAMES,
@@ -34,14 +35,17 @@ __all__ = [
     "PAIR_NAMES",
     "PROFILE_NAMES",
     "ContactGeometry",
+    "CriticalSpeed",
     "Profile",
     "ProfilePair",
+    "SuspendedWheelset",
     "TrackCrossSection",
     "WheelsetDimensions",
     "circular_rail",
     "circular_wheel",
     "coned_wheel",
     "contact_geometry",
+    "critical_speed",
     "en15302_rail_a",
     "en15302_wheel_a",
     "equivalent_conicity",
