@@ -88,9 +88,7 @@ def build(p: dict):
 def _roof_load_N(sub, eq) -> float:
     """What the pantograph puts on the roof at equilibrium: its weight plus the wire's push."""
     mass = sum(b.mass for b in sub.scene.rigid_bodies if b.name in PANTOGRAPH)
-    if "contact" in eq.contact_force_N:                      # penalty contact
-        return mass * G + float(eq.contact_force_N["contact"])
-    return mass * G - float(eq.reactions_N["contact"][2])  # sliding joint: reaction on the pan-head
+    return mass * G + cat.static_contact_force(eq)
 
 
 def _start_from(model, sub, eq) -> None:
@@ -119,16 +117,10 @@ def run(p: dict) -> ModelOutput:
         raise SolverError(f"{err} (seo2005: vehicle, pantograph and catenary; try a tighter rtol)") from err
     z = res.q[:, off + 2] - WIRE_HEIGHT_M
     acc = res.a[:, off + 2]
-    if p["contact"] == "bilateral":
-        force = -res.reactions_N["contact"][:, 2]
-        lost, s_hist = force < 0, res.s_m[:, 0]
-    else:
-        c = res.contacts["contact"]
-        force, lost, s_hist = c["force_N"], c["gap_m"] > 0, c["s_m"]
+    force, lost, s_hist = cat.contact_history(res, p["contact"])
     wheels = wheel_forces(res, layout)
     names = layout.contact_names
-    static_force = (-float(eq.reactions_N["contact"][2]) if p["contact"] == "bilateral"
-                    else float(eq.contact_force_N["contact"]))
+    static_force = cat.static_contact_force(eq)
     summary = {
         "panhead_z_mean_m": float(z.mean()), "panhead_z_std_m": float(z.std()),
         "contact_force_mean_N": float(force.mean()), "contact_force_std_N": float(force.std()),

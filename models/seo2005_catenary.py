@@ -200,6 +200,23 @@ def check(p: dict) -> None:
                              "or lengthen wire_length")
 
 
+def static_contact_force(eq) -> float:
+    """Pan-head/wire contact force (N, pushing the head down) of an equilibrium: the penalty
+    force, or minus the sliding joint's vertical reaction on the pan-head."""
+    if "contact" in eq.contact_force_N:
+        return float(eq.contact_force_N["contact"])
+    return -float(eq.reactions_N["contact"][2])
+
+
+def contact_history(res, contact: str):
+    """Contact force (N), contact-loss flags and arc length (m) of the pan-head over a run."""
+    if contact == "bilateral":
+        force = -res.reactions_N["contact"][:, 2]
+        return force, force < 0, res.s_m[:, 0]  # lost: the joint would have to pull the pan-head
+    c = res.contacts["contact"]
+    return c["force_N"], c["gap_m"] > 0, c["s_m"]
+
+
 def _atol(model, atol: float) -> np.ndarray:
     """Per-coordinate absolute tolerances: the cross-section gradients r_y, r_z of a beam3d
     wire (3 mm section: modes near 1e6 rad/s that carry no physics here) are not error-controlled
@@ -222,10 +239,7 @@ def run(p: dict) -> ModelOutput:
     eq = solve_equilibrium(model)
     eq.apply(model)
     off = _panhead_offset(model)
-    if p["contact"] == "bilateral":
-        static_force = -float(eq.reactions_N["contact"][2])
-    else:
-        static_force = float(eq.contact_force_N["contact"])
+    static_force = static_contact_force(eq)
     static = {"static_panhead_z_m": float(eq.q[off + 2]), "static_contact_force_N": static_force,
               "static_residual_N": eq.residual_N, "static_iterations": eq.iterations}
     if p["t_end"] == 0:
@@ -238,13 +252,7 @@ def run(p: dict) -> ModelOutput:
                    n_out=n_out)
     z = res.q[:, off + 2]
     acc = res.a[:, off + 2]
-    if p["contact"] == "bilateral":
-        force = -res.reactions_N["contact"][:, 2]
-        lost = force < 0  # the joint would have to pull the pan-head
-        s_hist = res.s_m[:, 0]
-    else:
-        c = res.contacts["contact"]
-        force, lost, s_hist = c["force_N"], c["gap_m"] > 0, c["s_m"]
+    force, lost, s_hist = contact_history(res, p["contact"])
     e = res.energy_J["total"]
     summary = {
         "panhead_z_mean_m": float(z.mean()), "panhead_z_std_m": float(z.std()),

@@ -69,7 +69,7 @@ def build(p: dict):
     return scene, layout, MultibodyModel(scene)
 
 
-def summarize(res, layout, t_end: float) -> dict:
+def summarize(res, layout) -> dict:
     """Summary quantities of a vehicle run (see the module docstring)."""
     forces = wheel_forces(res, layout)
     names = layout.contact_names
@@ -99,7 +99,7 @@ def run(p: dict) -> ModelOutput:
     except SolverError as err:
         raise SolverError(f"{err} (vehicle model: try index=ggl or a tighter rtol; a flange contact or a contact "
                           "jump may have been reached)") from err
-    summary = summarize(res, layout, p["t_end"])
+    summary = summarize(res, layout)
     stats = {k: res.stats[k] for k in ("nsteps", "nfevals", "netfails", "nncfails", "restarts")}
 
     def write(out):
