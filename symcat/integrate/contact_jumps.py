@@ -26,6 +26,10 @@ profiles' curvatures along its path, so that the calls shorten geometrically tow
 (c) the lowest formed rival is predicted :data:`JUMP_TOLERANCE_M` below it. The rates are exact:
 ``s_dot = -C_Ts^-1 C_Tq q_dot``, and the gap of a stationary point changes at
 ``C_q[gap] q_dot`` (its derivative in ``s`` vanishes there).
+
+The other minima are searched for with the wheelset moved onto the rail at the followed point
+(:func:`_minima`: micrometres of constraint drift would hide those of a flat valley). A wheel
+that would lift off or run off its rail ends the run with an error (:func:`lost_contact`).
 """
 from __future__ import annotations
 
@@ -51,7 +55,7 @@ FOLD_CURVATURE_PER_M = 0.05
 #: Largest travel of a followed contact point along the wheel profile between two checks (m).
 TRAVEL_M = 5e-4
 #: Shortest integrator call (s): the floor of the predicted spans and of retries after a failure.
-MIN_SPAN_S = 1e-5
+MIN_SPAN_S = 1e-6
 
 
 @dataclass
@@ -108,14 +112,19 @@ class ContactCheck:
     def target(self, relaxed: bool = False) -> Rival | None:
         """The rival to jump to, if any: the lowest formed one once it lies
         :data:`JUMP_TOLERANCE_M` below the followed point; or, when the followed point nears its
-        fold (or ``relaxed``: IDAS has failed), the lowest one below it at all, formed ones first."""
+        fold, the lowest one not higher than that tolerance, formed ones first (in a flat valley
+        of nearly conformal profiles the minima lie within a fraction of a nanometre, and the
+        followed one is about to vanish); or, ``relaxed`` (IDAS has failed on the followed
+        point), the lowest one."""
         formed = [r for r in self.rivals if r.formed]
         if formed and self.margin_m(formed[0]) < -JUMP_TOLERANCE_M:
             return formed[0]
-        if relaxed or self.curvature_per_m < FOLD_CURVATURE_PER_M:
-            lower = [r for r in self.rivals if self.margin_m(r) < 0]
-            lower.sort(key=lambda r: not r.formed)
-            return lower[0] if lower else None
+        if relaxed:
+            return self.rivals[0] if self.rivals else None
+        if self.curvature_per_m < FOLD_CURVATURE_PER_M:
+            level = [r for r in self.rivals if self.margin_m(r) < JUMP_TOLERANCE_M]
+            level.sort(key=lambda r: not r.formed)
+            return level[0] if level else None
         return None
 
     def span_s(self) -> float:

@@ -21,6 +21,8 @@ from .contact_jumps import MIN_SPAN_S, check_contacts, jump_contacts, lost_conta
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
+#: Relaxed jumps tried after consecutive failed calls from one state.
+RELAXED_JUMPS = 3
 
 
 class CallFailed(RuntimeError):
@@ -90,7 +92,8 @@ class ContactStepper:
 
     def advance(self, x, z, t0: float, t1: float):
         """State at ``t1`` from ``(x, z)`` at ``t0``, with the contacts checked after every call.
-        A failed call is retried from its start after a relaxed jump check (any lower point), else
+        A failed call is retried from its start after a relaxed jump check (a point about as low;
+        at most :data:`RELAXED_JUMPS` times in a row, lest two vanishing points alternate), else
         four times shorter.
 
         Raises
@@ -105,6 +108,7 @@ class ContactStepper:
         k_max = max(0, math.ceil(math.log2(dt / MIN_SPAN_S)))
         # The position in units of dt / 2^k_max and the length in levels k (dt / 2^k).
         pos, end = 0, 2**k_max
+        failures = 0
         while pos < end:
             k = min(k_max, max(0, math.ceil(math.log2(dt / self.span)))) if self.span < dt else 0
             while pos % 2 ** (k_max - k):
@@ -115,7 +119,8 @@ class ContactStepper:
                 x_new, z_new = self.call(x, z, t, h)
             except RuntimeError as exc:
                 self.stats["contact_retries"] += 1
-                x, z, jumped = self._after(x, z, t, relaxed=True)
+                failures += 1
+                x, z, jumped = self._after(x, z, t, relaxed=failures <= RELAXED_JUMPS)
                 if jumped:
                     continue
                 if k >= k_max:
@@ -125,6 +130,7 @@ class ContactStepper:
             except (SolverError, ParameterError) as exc:
                 raise CallFailed(t, x, z, exc) from None
             self.stats["contact_calls"] += 1
+            failures = 0
             pos += 2 ** (k_max - k)
             x, z, _ = self._after(x_new, z_new, t0 + dt * pos / end)
             reason = lost_contact(self.form, x, z, self.checks)

@@ -182,8 +182,9 @@ def test_jump_targets_need_a_formed_rival_below_the_tolerance():
     assert check(1.0, (-1e-6, newborn)).target() is None                       # may vanish again
     near_fold = 0.5 * FOLD_CURVATURE_PER_M
     assert check(near_fold, (-0.1 * JUMP_TOLERANCE_M, newborn)).target() is not None
-    assert check(near_fold, (1e-9, formed)).target() is None                   # nothing lower
-    assert check(1.0, (-0.1 * JUMP_TOLERANCE_M, formed)).target(relaxed=True) is not None
+    assert check(near_fold, (2 * JUMP_TOLERANCE_M, formed)).target() is None   # nothing as low
+    assert check(near_fold, (0.5 * JUMP_TOLERANCE_M, formed)).target() is not None  # a flat valley
+    assert check(1.0, (5e-9, formed), (1e-8, newborn)).target(relaxed=True).curvature_per_m == formed
     # Formed rivals are preferred when the followed point must go.
     both = check(near_fold, (-2e-9, newborn), (-1e-9, formed))
     assert both.target().curvature_per_m == formed
