@@ -22,6 +22,12 @@ Summary
     contact points) of the centred wheelset and ``gamma = Delta r / (2 y0)`` at the offset.
 ``normal_force_left_N``, ``normal_force_right_N``, ``rolling_radius_difference_m``
     At the static offset (t = 0): normal forces from the multipliers and ``r_left - r_right``.
+``normal_force_min_N``
+    Smallest normal force of either wheel over the run (a run stops with an error if a wheel
+    would lift off or run off its rail: one bilateral contact point per wheel cannot separate).
+
+The contact point of each wheel jumps where another point of the profiles comes lower (see
+:mod:`symcat.integrate.contact_jumps`; ``contact_jumps`` in the statistics).
 """
 from __future__ import annotations
 
@@ -113,8 +119,8 @@ def run(p: dict) -> ModelOutput:
         res = simulate(model, p["t_end"], formulation=p["formulation"], rtol=p["rtol"], n_out=int(p["n_out"]),
                        progress=p.get("progress", True))
     except SolverError as err:
-        raise SolverError(f"{err} (wheelset model: a flange contact or a contact jump may have been reached; "
-                          "the constraint contact follows one contact point per wheel)") from err
+        raise SolverError(f"{err} (wheelset model: one constraint contact point per wheel, which jumps to the "
+                          "lowest point of the gap; a free wheelset hunts, and at speed its flanges strike)") from err
     x, y = res.coordinate("wheelset.x"), res.coordinate("wheelset.y")
     left, right = res.wheelrail["left_wheel"], res.wheelrail["right_wheel"]
     radius = {k: placed.contacts[k].rolling_radius_m for k in ("left", "right")}
@@ -128,8 +134,10 @@ def run(p: dict) -> ModelOutput:
         "wall_s": float(res.stats["wall_s"]),
         "simulated_s": float(p["t_end"]),
         "max_position_drift_m": float(res.position_drift.max()),
+        "normal_force_min_N": float(min(left["normal_force_N"].min(), right["normal_force_N"].min())),
     }
-    stats = {k: res.stats[k] for k in ("nsteps", "nfevals", "netfails", "nncfails", "restarts")}
+    stats = {k: res.stats.get(k, 0) for k in ("nsteps", "nfevals", "netfails", "nncfails", "restarts", "contact_jumps",
+                                             "contact_calls", "contact_retries")}
     arrays = {"result": res}
 
     def write(out):

@@ -212,9 +212,8 @@ def creep_function(joint: WheelRailJoint, setup: CreepSetup, curved: bool = Fals
     if cm.law == "linear":
         fx, fy, mz = kalker_linear_forces(xi_x, xi_y, phi, setup.a_m, setup.b_m, coeff)
     else:
-        # Smooth max(N, 0): the multiplier may dip below zero where the constraint holds the wheel down.
-        eps = 1e-3 * setup.nominal_normal_force_N
-        n_pos = 0.5 * (normal + ca.sqrt(normal**2 + eps**2))
+        # The multiplier may dip below zero where the constraint holds the wheel down.
+        n_pos = smooth_positive(normal, 1e-3 * setup.nominal_normal_force_N)
         scale = (n_pos / setup.nominal_normal_force_N) ** (1.0 / 3.0)
         fx, fy, mz = polach_forces_casadi(xi_x, xi_y, phi, n_pos, setup.a_m * scale, setup.b_m * scale, coeff,
                                           friction_coefficient=cm.friction_coefficient)
@@ -227,28 +226,47 @@ def creep_function(joint: WheelRailJoint, setup: CreepSetup, curved: bool = Fals
                        ["x", "x_dot", "s", "p", "N"], ["Q", "creep"])
 
 
+def smooth_positive(x, eps):
+    """Smooth ``max(x, 0)``, ``(x + sqrt(x^2 + eps^2)) / 2`` (CasADi), written as
+    ``eps^2 / (2 (sqrt(x^2 + eps^2) - x))`` for ``x < 0``: the same value without the
+    cancellation that makes the first form exactly zero (and a creep law dividing by it NaN)
+    once ``|x| > 1e8 eps``. Value and derivative stay positive and finite for every ``x``."""
+    r = ca.sqrt(x**2 + eps**2)
+    return ca.if_else(x >= 0, 0.5 * (x + r), 0.5 * eps**2 / (r - x))
+
+
 def polach_forces_casadi(xi_x, xi_y, phi, normal_N, a_m, b_m, coefficients,
                          shear_modulus_Pa=SHEAR_MODULUS_STEEL_PA, friction_coefficient=0.3):
     """Polach's creep forces (1999 method, as :func:`symcat.wheelrail.polach_forces`) in CasADi
-    symbols, with the resultant creepage regularized at zero (``sqrt(s^2 + 1e-24)``) so that the
-    law is differentiable there; ``mz`` is zero (Polach has no spin moment)."""
+    symbols; ``mz`` is zero (Polach has no spin moment).
+
+    Written to be differentiable everywhere: the resultant creepages are regularized at zero
+    (``sqrt(s^2 + 1e-24)``), and the spin term ``K_M phi / s_c`` with ``K_M = eps_M h(eps_M^2)``
+    uses ``eps_M / s_c ~ |xi_y_c| / s_c = sqrt((xi_y_c^2 + 1e-24) / s_c^2)``, which is 1 for pure
+    spin (Kalker's linear ``-G (ab)^1.5 C23 phi`` at small spin) instead of the 0 that
+    ``|xi_y_c| / sqrt(xi_y_c^2 + 1e-24)`` gives there. Polach's combined coefficient
+    ``C = sqrt((C11 xi_x)^2 + (C22 xi_y)^2) / s`` depends on the direction of the creepage, so
+    the law itself has no derivative at zero creepage on scales above the regularization; the
+    Jacobian there is finite (``C = C11`` in every direction)."""
     c11, c22, c23, _ = coefficients
     g, mu = shear_modulus_Pa, friction_coefficient
     bound = mu * normal_N
     xi_y_edge = xi_y + phi * a_m
-    xi_y_c = ca.if_else(ca.fabs(xi_y_edge) > ca.fabs(xi_y), xi_y_edge, xi_y)
+    xi_y_c2 = ca.fmax(xi_y_edge**2, xi_y**2)  # the larger lateral creepage, squared
     tiny = 1e-24
     s = ca.sqrt(xi_x**2 + xi_y**2 + tiny)
-    s_c = ca.sqrt(xi_x**2 + xi_y_c**2 + tiny)
+    s_c2 = xi_x**2 + xi_y_c2 + tiny
+    s_c = ca.sqrt(s_c2)
     c_jj = ca.sqrt((c11 * xi_x) ** 2 + (c22 * xi_y) ** 2 + tiny * c11**2) / s
     eps = g * math.pi * a_m * b_m * c_jj * s_c / (4.0 * bound)
     force = 2.0 * bound / math.pi * (eps / (1.0 + eps**2) + ca.atan(eps))
     k_spin = 1.0 + 6.3 * (1.0 - ca.exp(-a_m / b_m))
-    eps_m = 8.0 / 3.0 * g * b_m * ca.sqrt(a_m * b_m) * c23 * ca.fabs(xi_y_c) / (bound * k_spin)
-    delta = (eps_m**2 - 1.0) / (eps_m**2 + 1.0)
-    # sqrt((1 - delta^2)^3) written as (2 e / (e^2 + 1))^3: smooth where the spin term vanishes.
-    k_m = eps_m * (delta**3 / 3.0 - delta**2 / 2.0 + 1.0 / 6.0) - (2.0 * eps_m / (eps_m**2 + 1.0)) ** 3 / 3.0
-    f_spin = 9.0 / 16.0 * a_m * bound * k_m * k_spin * phi / s_c
+    k_eps = 8.0 / 3.0 * g * b_m * ca.sqrt(a_m * b_m) * c23 / (bound * k_spin)  # eps_M / |xi_y_c|
+    e2 = k_eps**2 * xi_y_c2
+    delta = (e2 - 1.0) / (e2 + 1.0)
+    # K_M / eps_M; sqrt((1 - delta^2)^3) / eps_M = 8 eps_M^2 / (eps_M^2 + 1)^3.
+    h = delta**3 / 3.0 - delta**2 / 2.0 + 1.0 / 6.0 - 8.0 * e2 / (3.0 * (e2 + 1.0) ** 3)
+    f_spin = 9.0 / 16.0 * a_m * bound * k_eps * h * ca.sqrt((xi_y_c2 + tiny) / s_c2) * k_spin * phi
     return -force * xi_x / s_c, -force * xi_y / s_c + f_spin, 0 * xi_x
 
 

@@ -42,9 +42,12 @@ def locate_contacts(fn: ca.Function, q, v, s, w, t, sc, tol: float = 1e-12, max_
 
 
 def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max_iterations: int = 30,
-                     start: dict | None = None):
+                     start: dict | None = None, positions: bool = True):
     """Consistent ``(x0, z0)`` for ``form`` at time ``t0`` from the scene's initial state, or from
     ``start = {"q", "v", "s", "w", "sc"}`` (internal free coordinates; e.g. after a contact jump).
+    With ``positions=False`` the positions and arc lengths are kept as given (their constraint
+    drift is left to the Baumgarte terms) and only velocities, accelerations and multipliers are
+    made consistent.
 
     Raises
     ------
@@ -78,7 +81,7 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
         _check_rank(jac, names)
         scale = 1.0 + np.abs(np.r_[q, s]).max(initial=0.0)
         for _ in range(max_iterations):
-            if np.abs(c).max() <= tol * scale:
+            if not positions or np.abs(c).max() <= tol * scale:
                 break
             u = np.r_[q, s] - w_inv @ (jac.T @ _solve(jac @ w_inv @ jac.T, c))
             q, s = u[:n_f], u[n_f:]

@@ -1,66 +1,306 @@
-"""Contact-point jumps of wheel/rail constraint contacts between integrator calls.
+"""Contact-point jumps of wheel/rail constraint contacts, located between integrator calls.
 
 A constraint contact follows one stationary point of the wheel/rail gap continuously. On worn or
-nearly conformal profiles (S1002 on UIC60, EN 15302 wheel A on rail A) the lowest point jumps:
-another point of the profiles comes into contact while the followed one lifts off. Between two
-integrator calls the driver asks :meth:`WheelRailContact.solve` for the lowest point of each
-wheel from scratch; where it lies elsewhere on the profiles and lower (penetrating) than the
-followed one, the surface parameters move there and the state is projected back onto the
-constraints (positions, then velocities: the minimum-norm change, an impact-like velocity jump)
-before IDAS restarts. The rest of the run is the constraint formulation unchanged.
+nearly conformal profiles (S1002 on UIC60, EN 15302 wheel A on rail A) the gap along the wheel
+has several local minima a few millimetres apart and within fractions of a micrometre of each
+other: the lowest point jumps when another minimum sinks below the followed one. Followed any
+further, the old point keeps the wheel up while the new one penetrates, and soon after it meets
+a gap maximum and vanishes (a fold: the relative curvature ``kappa`` of wheel and rail across
+the profile, the reduced tangency Jacobian, goes through zero, ``C_s`` turns singular and the
+contact point would have to move infinitely fast). IDAS cannot pass a fold: it stalls
+(IDA_TOO_MUCH_WORK) or its Newton iterates leave the profiles (IDA_CONV_FAIL, inf/NaN in the
+Jacobian).
 
-On curved track the search is the same (:meth:`WheelRailContact.solve` projects the wheel onto
-the layout's cross-sections); a contact whose point has left the layout's defined length ends
-the run with a :class:`SolverError` naming it (the kernels would extrapolate the end piece).
+So the driver (:mod:`.contact_stepping`) integrates in short calls and, after each, looks at
+every wheel from scratch (:meth:`WheelRailContact.local_minima`). The contact jumps to the lowest
+other minimum that is *formed* (relative curvature at least :data:`FOLD_CURVATURE_PER_M`; a
+newborn minimum has none and may vanish again) once that lies :data:`JUMP_TOLERANCE_M` below the
+followed point (the hysteresis against chattering between twin minima), or to any lower one when
+the followed point nears its fold (``kappa`` below that) or IDAS has failed. The surface
+parameters move there and the velocities are projected onto the constraints (the minimum-norm
+change: a plastic impact at the new point) before IDAS restarts; the positions stay as they are.
+
+A call lasts at most until (a) the followed point has travelled :data:`TRAVEL_M` along the wheel
+profile, (b) about half the time until its relative curvature has halved (predicted from the
+profiles' curvatures along its path, so that the calls shorten geometrically toward a fold), or
+(c) the lowest formed rival is predicted :data:`JUMP_TOLERANCE_M` below it. The rates are exact:
+``s_dot = -C_Ts^-1 C_Tq q_dot``, and the gap of a stationary point changes at
+``C_q[gap] q_dot`` (its derivative in ``s`` vanishes there).
+
+The other minima are searched for with the wheelset moved onto the rail at the followed point
+(:func:`_minima`: micrometres of constraint drift would hide those of a flat valley). A wheel
+that would lift off or run off its rail ends the run with an error (:func:`lost_contact`), as
+does, on curved track, a contact point that has left the layout's defined length (the kernels
+would extrapolate the end piece).
 """
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..assembly.wheelrail import GAP_ROW, TANGENCY_ROWS
 from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
 from .failure import split_state
 
-#: A lowest point this much below the followed one (m) triggers a jump.
-JUMP_TOLERANCE_M = 1e-7
-#: Points closer than this along the wheel profile (m) are the same contact.
-SAME_POINT_M = 1e-4
+#: A minimum this much below the followed point (m) triggers a jump.
+JUMP_TOLERANCE_M = 1e-9
+#: Stationary points closer than this along the wheel profile (m) are the same point.
+SAME_POINT_M = 1e-6
+#: Farthest (m) the followed point's own stationary point is looked for from its parameters.
+OWN_RADIUS_M = 1e-5
+#: Relative curvature (1/m) below which the followed point is abandoned for any lower minimum
+#: (a relative radius above 20 m: a Hertz ellipse as wide as the rail head).
+FOLD_CURVATURE_PER_M = 0.05
+#: Largest travel of a followed contact point along the wheel profile between two checks (m).
+TRAVEL_M = 5e-4
+#: Shortest integrator call (s): the floor of the predicted spans and of retries after a failure.
+MIN_SPAN_S = 1e-6
 
 
-def jump_contacts(form, x, z, t: float):
-    """``(x, z, names)``: the state after moving every wheel/rail contact whose lowest point is
-    elsewhere (``names`` lists them; unchanged state and an empty list if none)."""
+@dataclass
+class Rival:
+    """Another local minimum of a wheel's gap: the contact point, its relative curvature (1/m)
+    and the rate of its gap (m/s)."""
+
+    point: object
+    curvature_per_m: float
+    gap_rate_m_s: float
+
+    @property
+    def formed(self) -> bool:
+        """Whether the minimum is pronounced enough to be followed (not about to vanish: a
+        newborn minimum appears with zero curvature)."""
+        return self.curvature_per_m >= FOLD_CURVATURE_PER_M
+
+
+@dataclass
+class ContactCheck:
+    """One wheel's contact at one state.
+
+    Attributes
+    ----------
+    name : str
+    gap_m, gap_rate_m_s : float
+        Normal gap of the followed point and its rate.
+    curvature_per_m : float
+        Relative curvature of wheel and rail across the profile at the followed point (> 0 at a
+        gap minimum, 0 at a fold), see :func:`relative_curvature`.
+    fold_in_s : float
+        Predicted time (s) until that curvature has halved (``inf``: not within the travel
+        :data:`TRAVEL_M`), see :func:`halving_time`.
+    s_rate : ndarray (4,)
+        Rates of the surface parameters (m/s, rad/s, m/s, m/s).
+    rivals : list of Rival
+        The other local minima of the gap, lowest first: all but the followed point's own (see
+        :func:`_own_point`). In a flat valley of nearly conformal profiles they may be tens of
+        micrometres away.
+    """
+
+    name: str
+    gap_m: float
+    gap_rate_m_s: float
+    curvature_per_m: float
+    fold_in_s: float
+    s_rate: np.ndarray
+    rivals: list = field(default_factory=list)
+
+    def margin_m(self, rival: Rival) -> float:
+        """Rival's gap minus the followed point's (m)."""
+        return rival.point.gap_m - self.gap_m
+
+    def target(self, relaxed: bool = False) -> Rival | None:
+        """The rival to jump to, if any: the lowest formed one once it lies
+        :data:`JUMP_TOLERANCE_M` below the followed point; or, when the followed point nears its
+        fold, the lowest one not higher than that tolerance, formed ones first (in a flat valley
+        of nearly conformal profiles the minima lie within a fraction of a nanometre, and the
+        followed one is about to vanish); or, ``relaxed`` (IDAS has failed on the followed
+        point), the lowest one."""
+        formed = [r for r in self.rivals if r.formed]
+        if formed and self.margin_m(formed[0]) < -JUMP_TOLERANCE_M:
+            return formed[0]
+        if relaxed:
+            return self.rivals[0] if self.rivals else None
+        if self.curvature_per_m < FOLD_CURVATURE_PER_M:
+            level = [r for r in self.rivals if self.margin_m(r) < JUMP_TOLERANCE_M]
+            level.sort(key=lambda r: not r.formed)
+            return level[0] if level else None
+        return None
+
+    def span_s(self) -> float:
+        """Longest next integrator call (s) for this contact: until the followed point has
+        travelled :data:`TRAVEL_M` along the wheel; half the predicted time until its relative
+        curvature has halved (the contact point speeds up toward a fold, where ``kappa`` goes as
+        ``sqrt(t_fold - t)``: the linear prediction would reach the fold itself); until the
+        lowest formed rival is predicted :data:`JUMP_TOLERANCE_M` below it (linearly, from the
+        rates). At least :data:`MIN_SPAN_S`."""
+        spans = [math.inf, 0.5 * self.fold_in_s]
+        if abs(self.s_rate[0]) > 0:
+            spans.append(TRAVEL_M / abs(self.s_rate[0]))
+        formed = [r for r in self.rivals if r.formed]
+        if formed and formed[0].gap_rate_m_s < self.gap_rate_m_s:
+            closing = self.gap_rate_m_s - formed[0].gap_rate_m_s
+            spans.append((self.margin_m(formed[0]) + 2 * JUMP_TOLERANCE_M) / closing)
+        return max(min(spans), MIN_SPAN_S)
+
+
+def relative_curvature(contact, q, s) -> float:
+    """Relative curvature (1/m) of wheel and rail across the profile at surface parameters ``s``:
+    the derivative of the wheel-profile tangency row ``t1w . n^r`` along the wheel profile's arc
+    length with the other three conditions held (a Schur complement of ``C_s``). Equal to
+    ``-(k_wheel + k_rail)`` of the profiles' curvatures (:meth:`Profile.curvature`) on tangent
+    track; positive at a minimum of the gap, zero where the point meets a maximum and vanishes."""
+    k = contact.evaluate(q, s, clip=True)
+    t = k.C_s
+    rows, cols = [0, 1, 4], [1, 2, 3]
+    reduced = t[3, 0] - t[3, cols] @ np.linalg.solve(t[np.ix_(rows, cols)], t[rows, 0])
+    return float(reduced / np.hypot(*contact.wheel.derivative(s[0])))
+
+
+def halving_time(contact, s, s_rate, kappa: float, samples: int = 64) -> float:
+    """Time (s) until the relative curvature of a contact point moving at ``s_rate`` has halved
+    (or dropped below :data:`FOLD_CURVATURE_PER_M`), predicted over a travel of :data:`TRAVEL_M`
+    from the profiles' curvatures along the linearly extrapolated path (``-(k_wheel + k_rail)``,
+    as :func:`relative_curvature` on tangent track): measured profiles have their curvature
+    changing over fractions of a millimetre, which a rate at the point cannot see. ``inf`` if
+    it does not within that travel."""
+    if kappa <= 0 or s_rate[0] == 0:
+        return math.inf
+    tau = np.linspace(0.0, TRAVEL_M / abs(s_rate[0]), samples + 1)[1:]
+    w = np.clip(s[0] + s_rate[0] * tau, contact.wheel.s_min, contact.wheel.s_max)
+    r = np.clip(s[3] + s_rate[3] * tau, contact.rail.s_min, contact.rail.s_max)
+    path = -(contact.wheel.curvature(w) + contact.rail.curvature(r))
+    # The path's curvatures are relative to the point's own (3D effects: roll, yaw).
+    path += kappa + (contact.wheel.curvature(s[0]) + contact.rail.curvature(s[3]))
+    low = np.flatnonzero(path <= max(0.5 * kappa, FOLD_CURVATURE_PER_M))
+    return float(tau[low[0]]) if low.size else math.inf
+
+
+def check_contacts(form, x, z) -> list[ContactCheck]:
+    """:class:`ContactCheck` of every wheel/rail contact at the state ``(x, z)``."""
+    model = form.model
+    parts = split_state(form, x, z)
+    q_full, v_full = model.q0.copy(), np.zeros(model.n_q)
+    q_full[model.free] = form.to_physical(parts["q"])
+    v_full[model.free] = form.to_physical(parts["v"])
+    out = []
+    for e in model.wheelrail:
+        q, q_dot = q_full[e.rows], v_full[e.rows]
+        s = parts["s"][e.s_index : e.s_index + 4]
+        k = e.contact.evaluate(q, s, clip=True)
+        tr = list(TANGENCY_ROWS)
+        s_rate = -np.linalg.solve(k.C_s[tr], k.C_q[tr] @ q_dot)
+        gap = e.contact.gap(q, s)
+        kappa = relative_curvature(e.contact, q, s)
+        check = ContactCheck(e.joint.name, gap, float(k.C_q[GAP_ROW] @ q_dot + k.C_s[GAP_ROW] @ s_rate), kappa,
+                             halving_time(e.contact, s, s_rate, kappa), s_rate)
+        own = _own_point(e.contact, q, s, k)
+        for p in _minima(e.contact, q, s, gap * k.C_q[GAP_ROW, :3]):
+            if own is None or abs(p.s[0] - own) > SAME_POINT_M:
+                rate = float(e.contact.evaluate(q, p.s).C_q[GAP_ROW] @ q_dot)
+                check.rivals.append(Rival(p, relative_curvature(e.contact, q, p.s), rate))
+        out.append(check)
+    return out
+
+
+def _minima(contact, q, s, offset) -> list:
+    """Local minima of the gap at ``q`` (lowest first), searched for with the wheelset moved by
+    ``-offset`` (the followed point's gap along the rail normal) onto the rail: the vertical
+    clearances of the search differ from normal gaps by ``gap * tan(angle) * d(angle)``, which
+    with micrometres of constraint drift shifts or erases the minima of a flat valley (tenths of
+    a millimetre apart, nanometres deep). Each is then refined at ``q`` itself."""
+    q_touch = np.array(q, float)
+    q_touch[:3] -= offset
+    try:
+        found = contact.local_minima(q_touch, near=s[0])
+    except SolverError:
+        return []
+    out = []
+    for p in found:
+        try:
+            p = contact.solve(q, p.s, local=True)
+        except (SolverError, ParameterError):
+            continue
+        if all(abs(p.s[0] - o.s[0]) > SAME_POINT_M for o in out):
+            out.append(p)
+    return sorted(out, key=lambda p: p.gap_m)
+
+
+def _own_point(contact, q, s, kernels) -> float | None:
+    """Wheel parameter (m) of the followed point's own exact stationary point: the followed
+    parameters ``s`` are off it by the constraint drift (over the relative curvature). Newton
+    from ``s`` finds it, unless it has vanished (past a fold): then Newton goes farther than
+    twice its first step predicts (perhaps to the next minimum), and there is none (None). Near
+    a fold that prediction is large: at most :data:`OWN_RADIUS_M` (beyond, the own point shows
+    up as a rival, and a jump there only corrects the parameters' drift)."""
+    start = np.array(s, float)
+    start[1] = math.remainder(start[1], 2 * math.pi)
+    tr = list(TANGENCY_ROWS)
+    predicted = abs(np.linalg.solve(kernels.C_s[tr], kernels.c[tr])[0])
+    try:
+        own = contact.solve(q, start, local=True).s[0]
+    except (SolverError, ParameterError):
+        return None
+    return own if abs(own - s[0]) <= min(2 * predicted + SAME_POINT_M, OWN_RADIUS_M) else None
+
+
+def lost_contact(form, x, z, checks) -> str | None:
+    """Why the constraint contacts stop describing the wheelset at the state ``(x, z)``, if they
+    do: a contact point off its profiles (the wheel ran off its rail or over its flange; the
+    kernels would extrapolate the end pieces) or a negative normal force (the wheel would lift:
+    a constraint cannot separate). Not the latter near a fold (``checks``: those of the state):
+    there the normal force of the vanishing point grows without bound either way, and the point
+    is about to jump."""
+    model = form.model
+    parts = split_state(form, x, z)
+    normal = -np.asarray(parts["lambda"])[form.normal_force_index()]
+    for e, n, check in zip(model.wheelrail, normal, checks):
+        s = parts["s"][e.s_index : e.s_index + 4]
+        try:
+            e.contact.frames.check(s[2])
+        except ParameterError as err:
+            return f"the {e.joint.name} contact point left the track: {err}"
+        for label, value, prof in (("wheel", s[0], e.contact.wheel), ("rail", s[3], e.contact.rail)):
+            if not prof.s_min <= value <= prof.s_max:
+                return (f"the {e.joint.name} contact point left the {label} profile {prof.name!r} (at "
+                        f"{value * 1e3:.2f} mm of {prof.s_min * 1e3:.2f} to {prof.s_max * 1e3:.2f} mm): the wheel has run "
+                        "off its rail")
+        if n < 0 and check.curvature_per_m >= FOLD_CURVATURE_PER_M:
+            return (f"{e.joint.name} lifts off its rail (normal force {n / 1e3:.3g} kN): the constraint contact "
+                    "cannot separate")
+    return None
+
+
+def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False):
+    """``(x, z, names)``: the state after moving every contact with a :meth:`ContactCheck.target`
+    there (``names`` lists them; unchanged state and an empty list if none). ``checks`` are those
+    of :func:`check_contacts` at this state (computed if not given)."""
     model = form.model
     if not model.wheelrail:
         return x, z, []
+    checks = check_contacts(form, x, z) if checks is None else checks
     parts = split_state(form, x, z)
-    q_full = model.q0.copy()
-    q_full[model.free] = form.to_physical(parts["q"])
     s = parts["s"].copy()
     jumped = []
-    for e in model.wheelrail:
-        q_body = q_full[e.rows]
-        i = e.s_index
-        current = s[i : i + 4]
-        try:
-            e.contact.frames.check(current[2])
-        except ParameterError as err:
-            raise SolverError(f"wheel/rail contact {e.joint.name!r} at t = {t:.6g} s: {err}") from None
-        try:
-            lowest = e.contact.solve(q_body)
-        except SolverError:
+    for e, c in zip(model.wheelrail, checks):
+        rival = c.target(relaxed)
+        if rival is None:
             continue
-        if lowest.gap_m < e.contact.gap(q_body, current) - JUMP_TOLERANCE_M and abs(lowest.s[0] - current[0]) > SAME_POINT_M:
-            new = lowest.s.copy()
-            # Keep the wheel angle continuous (it counts revolutions).
-            new[1] = current[1] + math.remainder(new[1] - current[1], 2 * math.pi)
-            s[i : i + 4] = new
-            jumped.append(e.joint.name)
+        i = e.s_index
+        new = rival.point.s.copy()
+        # Keep the wheel angle continuous (it counts revolutions).
+        new[1] = s[i + 1] + math.remainder(new[1] - s[i + 1], 2 * math.pi)
+        s[i : i + 4] = new
+        jumped.append(e.joint.name)
     if not jumped:
         return x, z, []
     start = {"q": parts["q"], "v": parts["v"], "s": s, "w": parts.get("w", np.zeros(form.n_s)),
              "sc": parts.get("sc", np.zeros(form.n_sc))}
-    x_new, z_new = consistent_state(form, t, start=start)
+    # Positions stay: the new point is an exact stationary point of the gap at them, and its
+    # gap differs from the old one's by the margin only (both carry the same constraint drift,
+    # which the Baumgarte terms remove). Projecting them onto C = 0 would shift and roll the
+    # wheelset by that drift (micrometres at speed), enough to reorder minima nanometres apart.
+    x_new, z_new = consistent_state(form, t, start=start, positions=False)
     return x_new, z_new, jumped

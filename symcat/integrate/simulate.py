@@ -1,7 +1,8 @@
 """Integrate a multibody model with CasADi's IDAS.
 
 The run is split into chunks of output points (progress, window moves of sliding joints);
-each chunk continues from the previous state. Accelerations and multipliers are algebraic and
+each chunk continues from the previous state (wheel/rail models: shorter calls with contact
+checks between them, :mod:`.contact_stepping`). Accelerations and multipliers are algebraic and
 kept out of the error test (``suppress_algebraic``): on stiff ANCF models this cuts the step
 count by two orders of magnitude. A failure raises :class:`SolverError` with the time, IDAS's
 reason, the largest residual by name and the result up to the last completed chunk.
@@ -22,7 +23,7 @@ from ..assembly.sparse import to_scipy
 from ..dae.initial import CreepCoupling, consistent_state, kkt_solve
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
-from .contact_jumps import jump_contacts
+from .contact_stepping import CallFailed, ContactStepper
 from .failure import failure, split_state
 
 STAT_KEYS = ("nsteps", "nfevals", "nlinsetups", "netfails", "nniters", "nncfails")
@@ -130,7 +131,8 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
         Absolute tolerance of the algebraic variables in IDAS's Newton test (they are not
         error-controlled).
     max_steps : int
-        IDAS steps allowed per chunk.
+        IDAS steps allowed per chunk (wheel/rail models: per call, at most
+        :data:`~symcat.integrate.contact_stepping.MAX_CALL_STEPS`).
     cholesky : bool
         Cholesky coordinates for the ANCF bodies (see :class:`symcat.dae.Formulation`).
     linear_solver : str
@@ -166,47 +168,59 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     bar = Progress("simulate", t_end, "s", enabled=progress)
     dae_fn = None
     done = 0
+
+    def call(x, z, t_a, times):
+        """One IDAS call from ``t_a`` with outputs at ``times``: (x, z) columns per output."""
+        # IDAS needs a consistent x_dot at every (re)start; it would otherwise assume zero.
+        x_dot = np.asarray(dae_fn(0.0, x, z, t_a, ca.DM(0, 1))[0]).ravel()
+        grid = (np.atleast_1d(times) - t_a).tolist()
+        integ = ca.integrator("idas", "idas", dae_fn, 0.0, grid, {**opts, "init_xdot": x_dot.tolist()})
+        out = integ(x0=x, z0=z, p=t_a)
+        st = integ.stats()
+        for k in STAT_KEYS:
+            stats[k] += int(st.get(k, 0))
+        return np.asarray(out["xf"]), np.asarray(out["zf"])
+
+    def dae_function():
+        d = form.dae()
+        # One Function per window: integrators built from it share its cached Jacobian.
+        return ca.Function("dae", [d["t"], d["x"], d["z"], d["p"], ca.MX.sym("u", 0)],
+                           [d["ode"], d["alg"], ca.MX(0, 1), ca.MX(0, 1)], ca.dyn_in(), ca.dyn_out())
+
     try:
-        a, limit = 0, None
+        if model.wheelrail:
+            # Short calls with contact checks between them (see contact_stepping).
+            dae_fn = dae_function()
+            stepper = ContactStepper(form, dae_fn, opts, x, z, stats, STAT_KEYS)
+            for a in range(n_out):
+                if _update_windows(model, form, x, z):
+                    stats["restarts"] += 1
+                    stepper.set_dae(dae_function())
+                try:
+                    x, z = stepper.advance(x, z, t_grid[a], t_grid[a + 1])
+                except CallFailed as exc:
+                    raise failure(form, exc.error, exc.t, exc.x, exc.z, stepper.dae_fn, t_grid[a + 1] - exc.t) from None
+                xs.append(x)
+                zs.append(z)
+                done = a + 1
+                bar.update(t_grid[a + 1])
+        a, limit = (n_out if model.wheelrail else 0), None
         while a < n_out:
             b = _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges)
             if limit is not None:
                 b = min(b, a + limit)
             if _update_windows(model, form, x, z) or dae_fn is None:
                 stats["restarts"] += dae_fn is not None
-                d = form.dae()
-                # One Function per window: integrators built from it share its cached Jacobian.
-                dae_fn = ca.Function("dae", [d["t"], d["x"], d["z"], d["p"], ca.MX.sym("u", 0)],
-                                     [d["ode"], d["alg"], ca.MX(0, 1), ca.MX(0, 1)], ca.dyn_in(), ca.dyn_out())
-            grid = t_grid[a : b + 1] - t_grid[a]
-            # IDAS needs a consistent x_dot at every (re)start; it would otherwise assume zero.
-            x_dot = np.asarray(dae_fn(0.0, x, z, t_grid[a], ca.DM(0, 1))[0]).ravel()
-            integ = ca.integrator("idas", "idas", dae_fn, 0.0, grid[1:].tolist(), {**opts, "init_xdot": x_dot.tolist()})
+                dae_fn = dae_function()
             try:
-                out = integ(x0=x, z0=z, p=t_grid[a])
+                xf, zf = call(x, z, t_grid[a], t_grid[a + 1 : b + 1])
             except RuntimeError as exc:
-                if b - a > 1 and model.wheelrail:
-                    # A contact point may have had to jump inside the call: retry shorter, so
-                    # the jump is found at an output between calls.
-                    stats["retries"] = stats.get("retries", 0) + 1
-                    limit = max(1, (b - a) // 2)
-                    continue
-                if model.wheelrail:
-                    # A wheel/rail contact point may have had to jump (see contact_jumps).
-                    x, z, jumped = jump_contacts(form, x, z, t_grid[a])
-                    if jumped:
-                        stats["contact_jumps"] = stats.get("contact_jumps", 0) + len(jumped)
-                        continue
                 if b - a > 1 and model.windowed():
                     # Possibly a sliding point left its window: retry shorter before giving up.
                     stats["retries"] = stats.get("retries", 0) + 1
                     limit = max(1, (b - a) // 2)
                     continue
                 raise failure(form, exc, t_grid[a], x, z, dae_fn, t_grid[a + 1] - t_grid[a]) from None
-            st = integ.stats()
-            for k in STAT_KEYS:
-                stats[k] += int(st.get(k, 0))
-            xf, zf = np.asarray(out["xf"]), np.asarray(out["zf"])
             if b - a > 1 and any(_left_window(model, form, xf[:, j], zf[:, j]) for j in range(b - a)):
                 # A sliding point ran out of its window inside the call (the physics there would
                 # be an extrapolated element): redo the call, shorter, from the same state.
@@ -215,18 +229,9 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
                 continue
             limit = None
             for j in range(b - a):
-                x, z = xf[:, j], zf[:, j]
-                jumped = []
-                if model.wheelrail:
-                    # Contact jumps are looked for at every output; the outputs after a jump
-                    # are discarded and the integrator restarts from the jumped state.
-                    x, z, jumped = jump_contacts(form, x, z, t_grid[a + j + 1])
-                xs.append(x)
-                zs.append(z)
-                if jumped:
-                    stats["contact_jumps"] = stats.get("contact_jumps", 0) + len(jumped)
-                    b = a + j + 1
-                    break
+                xs.append(xf[:, j])
+                zs.append(zf[:, j])
+            x, z = xf[:, -1], zf[:, -1]
             done = b
             bar.update(t_grid[b])
             a = b

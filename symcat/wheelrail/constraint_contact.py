@@ -290,12 +290,66 @@ class WheelRailContact:
             grid = np.linspace(max(grid[j] - h, lo), min(grid[j] + h, hi), 9)
         return np.array([best[0], s2w, best[2], best[1]])
 
+    def local_minima(self, q, band_m: float = 2e-6, grid_m: float = 2.5e-4, near: float | None = None
+                     ) -> list[ContactPoint]:
+        """Every local minimum of the gap along the wheel profile, refined by Newton to a contact
+        point; lowest first, each point once. Each wheel circle (``s1w`` on a grid of ``grid_m``,
+        20 um within 1.5 mm of ``near``) gives its lowest clearance over the rail (along the
+        track's ``up``), at the bottom or, by a parabola through three angles, ahead of or behind
+        it (a yawed wheelset touches its flange off the axle plane). Circles that are local minima
+        within ``band_m`` of the lowest are refined (the band covers the grid's error
+        ``kappa h^2 / 8``, 0.8 um at a 10 mm flange-root radius); Newton starts that leave a
+        profile are skipped.
+
+        Raises
+        ------
+        SolverError
+            If no wheel circle lies above the rail.
+        """
+        q = np.asarray(q, float)
+        a = _rotation(q[3:7])
+        s_axle = self.frames.project(q[None, :3])
+        self.frames.check(s_axle)
+        w = a.T @ self.frames.up(s_axle)
+        bottom = math.atan2(-w[0], w[2])
+        lo, hi = self.wheel.s_min, self.wheel.s_max
+        grid = np.linspace(lo, hi, max(int(math.ceil((hi - lo) / grid_m)), 8) + 1)
+        if near is not None:
+            grid = np.union1d(grid, np.clip(near + np.arange(-1.5e-3, 1.5e-3 + 1e-9, 2e-5), lo, hi))
+        step = 0.05  # rad
+        g = [np.nan_to_num(self._vertical_gap(q, a, bottom + k * step, grid, s_axle)[0], nan=np.inf)
+             for k in (-1, 0, 1)]
+        with np.errstate(invalid="ignore", divide="ignore"):  # inf off the rail
+            curv = g[0] + g[2] - 2 * g[1]
+            shift = np.where(curv > 0, 0.5 * step * (g[0] - g[2]) / curv, 0.0)
+        s2w = bottom + np.clip(np.nan_to_num(shift), -3 * step, 3 * step)
+        gap, s2r, s1r = self._vertical_gap(q, a, s2w, grid, s_axle)
+        gap = np.minimum(np.where(np.isfinite(gap), gap, np.inf), g[1])
+        if not np.isfinite(gap).any():
+            raise SolverError(f"{self.side} wheel: no point of the wheel lies above the rail at "
+                              f"q={np.array2string(q, precision=5)} (wheelset off the rail)")
+        lower = (gap <= np.r_[np.inf, gap[:-1]]) & (gap <= np.r_[gap[1:], np.inf])
+        points: list[ContactPoint] = []
+        for j in np.flatnonzero(lower & (gap <= gap.min() + band_m)):
+            if np.isfinite(s2r[j]):
+                r2, r1 = s2r[j], s1r[j]
+            else:
+                _, r2s, r1s = self._vertical_gap(q, a, bottom, grid[j : j + 1], s_axle)
+                r2, r1 = r2s[0], r1s[0]
+            try:
+                p = self._newton(q, np.array([grid[j], s2w[j], r1, r2]), 1e-13, 40)
+            except (SolverError, ParameterError):
+                continue
+            if all(abs(p.s[0] - o.s[0]) > 1e-6 for o in points):
+                points.append(p)
+        return sorted(points, key=lambda p: p.gap_m)
+
     def _vertical_gap(self, q, a, s2w, s1w, s_guess):
         """Gap along the rail profile's ``z`` of the wheel points ``(s1w, s2w)``, the rail
         parameter below each, and the chainage of its cross-section."""
         pw = self.wheel.position(s1w)
         rho = self._head[1] + pw[:, 1]
-        u = np.stack([rho * math.sin(s2w), self.sign * (self._head[2] + pw[:, 0]), -rho * math.cos(s2w)])
+        u = np.stack([rho * np.sin(s2w), self.sign * (self._head[2] + pw[:, 0]), -rho * np.cos(s2w)])
         points = (q[:3, None] + a @ u).T
         s1r = self.frames.project(points, s_guess)
         R, A, _, _ = self.frames.frames(s1r)
@@ -307,7 +361,7 @@ class WheelRailContact:
         z_r[ok] = self.rail.position(s2r[ok])[:, 1]
         return local[2] - z_r, s2r, s1r
 
-    def solve(self, q, s_guess=None, *, tol: float = 1e-13, max_iter: int = 40) -> ContactPoint:
+    def solve(self, q, s_guess=None, *, tol: float = 1e-13, max_iter: int = 40, local: bool = False) -> ContactPoint:
         """Contact point of the wheelset at ``q``: the four surface parameters from the two
         in-plane coincidence and two tangency conditions, and the normal gap (the fifth).
 
@@ -316,11 +370,9 @@ class WheelRailContact:
         rail normal ``n`` taken out), so both forms define the same point. Newton (with
         backtracking on the residual) starts from ``s_guess`` (e.g. the previous step's
         solution), else from :meth:`initial_guess` (the lowest point of the vertical-gap search),
-        and, should it fail from ``s_guess``, once more from :meth:`initial_guess`. It returns
-        the stationary point of the gap that Newton reaches: on nearly conformal profiles
-        (EN 15302 wheel A on rail A) secondary local minima of the gap lie within 0.2 um of the
-        lowest one and a few millimetres away, so a guess that far off may land on one of them
-        (the contact jump of a constraint formulation; without ``s_guess`` the lowest is found).
+        and, should it fail from ``s_guess`` (unless ``local``), once more from there. It returns
+        the stationary point of the gap that Newton reaches: on nearly conformal profiles secondary
+        minima lie within 0.2 um of the lowest one (without ``s_guess`` the lowest is found).
 
         Raises
         ------
@@ -332,7 +384,8 @@ class WheelRailContact:
             try:
                 return self._newton(q, np.array(s_guess, float), tol, max_iter)
             except SolverError:
-                pass
+                if local:
+                    raise
         return self._newton(q, self.initial_guess(q), tol, max_iter)
 
     def _newton(self, q, s, tol, max_iter) -> ContactPoint:

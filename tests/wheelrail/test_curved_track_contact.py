@@ -313,6 +313,6 @@ def test_running_off_the_layout_stops_the_run_with_its_chainage():
                         angular_velocity=tuple(placed.rotation[:, 1] * SPEED / 0.46)))
     for side in ("left", "right"):
         scene.add(WheelRailJoint(f"wr_{side}", "ws", side, pair.wheel, pair.rail, track=layout))
-    with pytest.raises(SolverError, match=r"'wr_left' at t = .* leaves the track, defined for 0 <= s1r <= 6 m") as err:
+    with pytest.raises(SolverError, match=r"at t = .* the wr_left contact point left the track: .* defined for 0 <= s1r <= 6 m") as err:
         simulate(MultibodyModel(scene), 1.0, n_out=10, progress=False)
     assert err.value.partial is not None

@@ -1,0 +1,139 @@
+"""The IDAS driver of wheel/rail models: short integrator calls with contact checks between them
+(see :mod:`.contact_jumps` for what is checked and how long a call may be).
+
+The calls are many (hundreds per simulated second while a contact point crosses a nearly
+conformal region) and building an integrator costs about as much as a short call, so the call
+lengths are binary fractions ``dt / 2^k`` of the output interval, aligned so that they add up
+to it exactly, and one integrator per ``k`` serves all calls of that length. IDAS finds the
+consistent ``x_dot`` itself at each start (``calc_ic``: exact for the semi-explicit DAE).
+(An integrator in normalized time ``tau = (t - t_a) / h`` would serve every length, but IDAS
+then takes a hundred times longer to give up at a fold.)
+"""
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import numpy as np
+
+from ..errors import ParameterError, SolverError
+from .contact_jumps import MIN_SPAN_S, check_contacts, jump_contacts, lost_contact
+
+#: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
+MAX_CALL_STEPS = 20000
+#: Relaxed jumps tried after consecutive failed calls from one state.
+RELAXED_JUMPS = 3
+
+
+class CallFailed(RuntimeError):
+    """An integrator call failed at the shortest span: the last good state and IDAS's error."""
+
+    def __init__(self, t: float, x, z, error: Exception):
+        super().__init__(str(error))
+        self.t, self.x, self.z, self.error = t, x, z, error
+
+
+class ContactStepper:
+    """Integrates a wheel/rail model between output times.
+
+    Parameters
+    ----------
+    form : Formulation
+    dae_fn : casadi.Function
+        ``(t, x, z, p, u) -> (ode, alg, ...)`` with ``t`` relative to ``p`` (the driver's DAE).
+    opts : dict
+        IDAS options.
+    x, z : ndarray
+        The consistent initial state.
+    stats : dict
+        Summed IDAS statistics (``stat_keys``) and the counts ``contact_jumps``,
+        ``contact_calls`` and ``contact_retries``.
+    """
+
+    def __init__(self, form, dae_fn, opts: dict, x, z, stats: dict, stat_keys=()):
+        self.form = form
+        self.stats = stats
+        self.stat_keys = stat_keys
+        for key in ("contact_jumps", "contact_calls", "contact_retries"):
+            stats.setdefault(key, 0)
+        self.opts = {**{k: v for k, v in opts.items() if k != "init_xdot"}, "calc_ic": True}
+        # A call is at most one output interval: this many steps mean a singularity (a fold
+        # passed unnoticed), and the retry, shorter and after a jump check, beats waiting.
+        self.opts["max_num_steps"] = min(int(opts.get("max_num_steps", MAX_CALL_STEPS)), MAX_CALL_STEPS)
+        self.set_dae(dae_fn)
+        self.span = min(c.span_s() for c in check_contacts(form, x, z))
+
+    def set_dae(self, dae_fn) -> None:
+        """Use ``dae_fn`` from now on (e.g. after a window moved)."""
+        self.dae_fn = dae_fn
+        self._integrators = {}
+
+    def call(self, x, z, t_a: float, h: float):
+        """State at ``t_a + h`` (one IDAS call; ``RuntimeError`` on failure)."""
+        key = float(f"{h:.12e}")  # output intervals differ in the last bits
+        integ = self._integrators.get(key)
+        if integ is None:
+            integ = self._integrators[key] = ca.integrator("idas", "idas", self.dae_fn, 0.0, [h], self.opts)
+        out = integ(x0=x, z0=z, p=t_a)
+        st = integ.stats()
+        for k in self.stat_keys:
+            self.stats[k] += int(st.get(k, 0))
+        return np.asarray(out["xf"])[:, -1], np.asarray(out["zf"])[:, -1]
+
+    def _after(self, x, z, t, relaxed=False):
+        checks = check_contacts(self.form, x, z)
+        x, z, jumped = jump_contacts(self.form, x, z, t, checks, relaxed)
+        if jumped:
+            self.stats["contact_jumps"] += len(jumped)
+            checks = check_contacts(self.form, x, z)
+        self.span = min(c.span_s() for c in checks)
+        self.checks = checks
+        return x, z, jumped
+
+    def advance(self, x, z, t0: float, t1: float):
+        """State at ``t1`` from ``(x, z)`` at ``t0``, with the contacts checked after every call.
+        A failed call is retried from its start after a relaxed jump check (a point about as low;
+        at most :data:`RELAXED_JUMPS` times in a row, lest two vanishing points alternate), else
+        four times shorter.
+
+        Raises
+        ------
+        CallFailed
+            If a call of the shortest length (:data:`MIN_SPAN_S` or just above) fails without a
+            jump to try.
+        SolverError
+            If a wheel runs off its rail or lifts off (:func:`lost_contact`).
+        """
+        dt = t1 - t0
+        k_max = max(0, math.ceil(math.log2(dt / MIN_SPAN_S)))
+        # The position in units of dt / 2^k_max and the length in levels k (dt / 2^k).
+        pos, end = 0, 2**k_max
+        failures = 0
+        while pos < end:
+            k = min(k_max, max(0, math.ceil(math.log2(dt / self.span)))) if self.span < dt else 0
+            while pos % 2 ** (k_max - k):
+                k += 1  # aligned, so that the calls end exactly on t1
+            t = t0 + dt * pos / end
+            h = dt / 2**k
+            try:
+                x_new, z_new = self.call(x, z, t, h)
+            except RuntimeError as exc:
+                self.stats["contact_retries"] += 1
+                failures += 1
+                x, z, jumped = self._after(x, z, t, relaxed=failures <= RELAXED_JUMPS)
+                if jumped:
+                    continue
+                if k >= k_max:
+                    raise CallFailed(t, x, z, exc) from None
+                self.span = h / 4
+                continue
+            except (SolverError, ParameterError) as exc:
+                raise CallFailed(t, x, z, exc) from None
+            self.stats["contact_calls"] += 1
+            failures = 0
+            pos += 2 ** (k_max - k)
+            x, z, _ = self._after(x_new, z_new, t0 + dt * pos / end)
+            reason = lost_contact(self.form, x, z, self.checks)
+            if reason is not None:
+                raise SolverError(f"at t = {t0 + dt * pos / end:.6g} s {reason}; the results so far are in .partial")
+        return x, z
