@@ -24,6 +24,13 @@ Penalty contacts (:class:`symcat.scene.PenaltyContact`) add, in every form, alge
 ``s_c`` (z block ``sc``) with the tangency equations ``0 = T(q, s_c)`` (no multiplier, seed
 Section 8) and their normal forces to ``Q``.
 
+Wheel/rail contacts in the rail-frame form (eq. 22) may be *open* (lifted off): the DAE's
+parameter is ``p = [t0, open]`` with ``open`` 0 or 1 per wheel/rail contact, and an open
+contact's gap row (position, velocity or acceleration level) is replaced by its multiplier
+(``lambda = 0``, in GGL also ``mu = 0``): the surface parameters still follow the closest point
+(the four other rows), and the gap is free. :mod:`symcat.integrate.contact_switching` opens and
+closes them.
+
 Accelerations and multipliers are algebraic; the driver keeps them out of IDAS's error test.
 """
 from __future__ import annotations
@@ -171,6 +178,28 @@ class Formulation:
         c_dot_r = ca.mtimes(h, v_f) + k["Ct"][rr]
         return {**k, "H": h, "Qcn": q_cn, "s_dot": s_dot, "CR": k["C"][rr], "CT": k["C"][tr], "CRdot": c_dot_r}
 
+    def releasable(self) -> list[int]:
+        """Wheel/rail contacts (positions in ``model.wheelrail``) that can open: those in the
+        rail-frame form, whose gap is a constraint row of its own."""
+        return [k for k, e in enumerate(self.model.wheelrail) if e.joint.form == "railframe"]
+
+    def open_rows(self, open_mask) -> list[int]:
+        """Constraint rows (model numbering) released by the open contacts ``open_mask``."""
+        return [e.row_start + GAP_ROW for k, e in enumerate(self.model.wheelrail)
+                if open_mask[k] and k in self.releasable()]
+
+    def _release(self, rows, replacement, open_p):
+        """``rows`` (the constraint rows of this form, or their multipliers' equations) with the
+        gap rows of open contacts replaced by ``replacement`` (their multipliers)."""
+        index = self.normal_force_index()
+        keep = self.releasable()
+        if not keep:
+            return rows
+        sel = sps.csc_matrix((np.ones(len(keep)), ([index[k] for k in keep], keep)),
+                             shape=(rows.shape[0], len(self.model.wheelrail)))
+        mask = ca.mtimes(ca.DM(to_casadi_sparse(sel)), open_p)
+        return (1 - mask) * rows + mask * replacement
+
     def normal_force_index(self) -> list[int]:
         """Positions, in this form's multiplier vector, of the gap row of every wheel/rail
         contact (its normal force is minus that multiplier)."""
@@ -212,12 +241,14 @@ class Formulation:
         return _layout(x), _layout(z)
 
     def dae(self) -> dict:
-        """CasADi DAE dict ``{x, z, p, t, ode, alg}``; ``p`` is the time offset of the chunk."""
+        """CasADi DAE dict ``{x, z, p, t, ode, alg}``; ``p`` is the time offset of the chunk and
+        the open flags of the wheel/rail contacts (see the module's notes)."""
         xb, zb = self.blocks()
         x = ca.MX.sym("x", sum(b.size for b in xb.values()))
         z = ca.MX.sym("z", sum(b.size for b in zb.values()))
         t_rel = ca.MX.sym("t")
         t0 = ca.MX.sym("t0")
+        open_p = ca.MX.sym("open", len(self.model.wheelrail))
         t = t0 + t_rel
         X = {k: x[b.slice] for k, b in xb.items()}
         Z = {k: z[b.slice] for k, b in zb.items()}
@@ -231,27 +262,30 @@ class Formulation:
                 dyn -= self.creep_force(k, X["s"], w, Z["lambda"])[0]
             free_s = ca.mtimes(k["Cs"].T, Z["lambda"])
             c_dot = ca.mtimes(k["Cq"], X["v"]) + ca.mtimes(k["Cs"], w) + k["Ct"]
+            lam = Z["lambda"]
             if self.index == "1":
                 acc = ca.mtimes(k["Cq"], Z["a"]) + ca.mtimes(k["Cs"], Z["s_dd"]) + k["Qd"] + 2 * al * c_dot + be**2 * k["C"]
                 ode = ca.vertcat(X["v"], w, Z["a"], Z["s_dd"])
-                alg = ca.vertcat(dyn, free_s, acc)
+                alg = ca.vertcat(dyn, free_s, self._release(acc, lam, open_p))
             else:
                 ode = ca.vertcat(X["v"] + ca.mtimes(k["Cq"].T, Z["mu"]), w + ca.mtimes(k["Cs"].T, Z["mu"]), Z["a"])
-                alg = ca.vertcat(dyn, free_s, k["C"], c_dot)
+                alg = ca.vertcat(dyn, free_s, self._release(k["C"], Z["mu"], open_p), self._release(c_dot, lam, open_p))
         else:
             k = self.embedded_terms(X["q"], X["v"], Z["s"], t, sc)
             dyn = ca.mtimes(k["M"], Z["a"]) + ca.mtimes(k["H"].T, Z["lambda"]) - k["Q"]
             if has_creep(self.model):
                 dyn -= self.creep_force(k, Z["s"], k["s_dot"], Z["lambda"])[0]
+            lam = Z["lambda"]
             if self.index == "1":
                 acc = ca.mtimes(k["H"], Z["a"]) + k["Qcn"] + 2 * al * k["CRdot"] + be**2 * k["CR"]
                 ode = ca.vertcat(X["v"], Z["a"])
-                alg = ca.vertcat(dyn, k["CT"], acc)
+                alg = ca.vertcat(dyn, k["CT"], self._release(acc, lam, open_p))
             else:
                 ode = ca.vertcat(X["v"] + ca.mtimes(k["H"].T, Z["mu"]), Z["a"])
-                alg = ca.vertcat(dyn, k["CT"], k["CR"], k["CRdot"])
+                alg = ca.vertcat(dyn, k["CT"], self._release(k["CR"], Z["mu"], open_p),
+                                 self._release(k["CRdot"], lam, open_p))
         alg = ca.vertcat(alg, k["T"])
-        return {"x": x, "z": z, "p": t0, "t": t_rel, "ode": ode, "alg": alg}
+        return {"x": x, "z": z, "p": ca.vertcat(t0, open_p), "t": t_rel, "ode": ode, "alg": alg}
 
     def residual_names(self) -> list[str]:
         """Names of the algebraic residual rows (for failure reports)."""

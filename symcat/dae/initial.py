@@ -42,12 +42,15 @@ def locate_contacts(fn: ca.Function, q, v, s, w, t, sc, tol: float = 1e-12, max_
 
 
 def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max_iterations: int = 30,
-                     start: dict | None = None, positions: bool = True):
+                     start: dict | None = None, positions: bool = True, open_rows=(), impulse: bool = False):
     """Consistent ``(x0, z0)`` for ``form`` at time ``t0`` from the scene's initial state, or from
     ``start = {"q", "v", "s", "w", "sc"}`` (internal free coordinates; e.g. after a contact jump).
     With ``positions=False`` the positions and arc lengths are kept as given (their constraint
     drift is left to the Baumgarte terms) and only velocities, accelerations and multipliers are
-    made consistent.
+    made consistent. ``open_rows`` (model row numbers: the gap rows of lifted wheel/rail
+    contacts, :meth:`Formulation.open_rows`) are left out, their multipliers zero. With
+    ``impulse`` the velocities change by a plastic impact (``M dv = -C_q^T Lambda``: the
+    mass-weighted least change) instead of the least change in coordinates.
 
     Raises
     ------
@@ -63,20 +66,24 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     sc = model.sc0.copy()
     if start is not None:
         q, v, s, w, sc = (np.array(start[k], float) for k in ("q", "v", "s", "w", "sc"))
-    names = model.row_names
+    closed = np.setdiff1d(np.arange(form.n_c), np.asarray(open_rows, int))
+    names = [model.row_names[r] for r in closed]
     n_f = form.n_f
 
     def evaluate(q, v, s, w):
+        """The closed rows' terms."""
         out = fn(q, v, s, w, t0, sc)
         c, cq, cs, ct, qd, m, f = out[:7]
-        return (np.asarray(c).ravel(), sps.hstack([to_scipy(cq), to_scipy(ca.DM(cs))]).tocsc(),
-                np.asarray(ct).ravel(), np.asarray(qd).ravel(), to_scipy(m), np.asarray(f).ravel(),
-                to_scipy(ca.DM(cq)), np.asarray(ca.densify(cs)))
+        cq = to_scipy(ca.DM(cq)).tocsr()[closed].tocsc()
+        cs = np.asarray(ca.densify(cs))[closed]
+        return (np.asarray(c).ravel()[closed], sps.hstack([cq, sps.csc_matrix(cs)]).tocsc(),
+                np.asarray(ct).ravel()[closed], np.asarray(qd).ravel()[closed], to_scipy(m), np.asarray(f).ravel(),
+                cq, cs)
 
     # The arc lengths are not generalized coordinates: they move first (a tiny weight), so a
     # body keeps its given position and velocity and s follows it.
     w_inv = sps.diags(np.r_[np.ones(n_f), np.full(form.n_s, 1e6)])
-    if form.n_c:
+    if closed.size:
         c, jac, *_ = evaluate(q, v, s, w)
         _check_rank(jac, names)
         scale = 1.0 + np.abs(np.r_[q, s]).max(initial=0.0)
@@ -92,10 +99,14 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
                 f"initial conditions cannot be made consistent: after {max_iterations} projections the "
                 f"constraint {names[worst]} is still violated by {c[worst]:.3g}; check the joint positions"
             )
-        c, jac, ct, *_ = evaluate(q, v, s, w)
-        u_dot = np.r_[v, w]
-        u_dot -= w_inv @ (jac.T @ _solve(jac @ w_inv @ jac.T, jac @ u_dot + ct))
-        v, w = u_dot[:n_f], u_dot[n_f:]
+        c, jac, ct, _, m, _, cq, cs = evaluate(q, v, s, w)
+        if impulse:
+            dv, w, _ = kkt_solve(m, np.zeros(n_f), cq, cs, cq @ v + ct)
+            v = v + dv
+        else:
+            u_dot = np.r_[v, w]
+            u_dot -= w_inv @ (jac.T @ _solve(jac @ w_inv @ jac.T, jac @ u_dot + ct))
+            v, w = u_dot[:n_f], u_dot[n_f:]
     if form.n_sc:
         sc = locate_contacts(fn, q, v, s, w, t0, sc)
     c, jac, ct, qd, m, f, cq, cs = evaluate(q, v, s, w)
@@ -103,12 +114,25 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     x0 = np.zeros(sum(b.size for b in xb.values()))
     z0 = np.zeros(sum(b.size for b in zb.values()))
     creep = CreepCoupling(form, q, v, s, w)
+    def scatter(lam_closed, rows):
+        """Multipliers of ``rows`` (model numbering) from those of the closed ones (open: 0)."""
+        full = np.zeros(form.n_c)
+        full[closed] = lam_closed
+        return full[rows]
+
     if form.formulation == "augmented":
-        a, s_dd, lam = creep.solve(lambda force: kkt_solve(m, force, cq, cs, qd), f)
+        def augmented(force):
+            a, s_dd, lam = kkt_solve(m, force, cq, cs, qd)
+            return a, s_dd, scatter(lam, np.arange(form.n_c))
+
+        a, s_dd, lam = creep.solve(augmented, f)
         values_x = {"q": q, "s": s, "v": v, "w": w}
         values_z = {"a": a, "s_dd": s_dd, "w": w, "lambda": lam, "mu": np.zeros(form.n_c), "sc": sc}
     else:
-        tr, rr = form.rows_t, form.rows_r
+        # Positions among the closed rows (the tangency rows never open).
+        at = {r: i for i, r in enumerate(closed)}
+        tr = [at[r] for r in form.rows_t]
+        rr = [at[r] for r in form.rows_r if r in at]
         cq_d = cq.toarray() if form.n_s else cq
         if form.n_s:
             both = np.linalg.solve(cs[tr], np.c_[cq_d[tr], qd[tr]])
@@ -119,11 +143,13 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
         kkt = sps.bmat([[m, h.T], [h, None]], format="csc")
         def embedded(force):
             sol = _solve(kkt, np.r_[force, -q_cn])
-            return sol, sol[n_f:]
+            lam = np.zeros(form.n_c)
+            lam[closed[rr]] = sol[n_f:]
+            return sol, lam[form.rows_r]
 
-        sol = creep.solve(embedded, f)[0]
+        sol, lam = creep.solve(embedded, f)
         values_x = {"q": q, "v": v}
-        values_z = {"a": sol[:n_f], "s": s, "lambda": sol[n_f:], "mu": np.zeros(len(rr)), "sc": sc}
+        values_z = {"a": sol[:n_f], "s": s, "lambda": lam, "mu": np.zeros(len(form.rows_r)), "sc": sc}
     for name, b in xb.items():
         x0[b.slice] = values_x[name]
     for name, b in zb.items():

@@ -249,14 +249,15 @@ def _own_point(contact, q, s, kernels) -> float | None:
 def lost_contact(form, x, z, checks) -> str | None:
     """Why the constraint contacts stop describing the wheelset at the state ``(x, z)``, if they
     do: a contact point off its profiles (the wheel ran off its rail or over its flange; the
-    kernels would extrapolate the end pieces) or a negative normal force (the wheel would lift:
-    a constraint cannot separate). Not the latter near a fold (``checks``: those of the state):
-    there the normal force of the vanishing point grows without bound either way, and the point
-    is about to jump."""
+    kernels would extrapolate the end pieces) or, for a contact in the global form (eq. 21, no
+    gap row to release: rail-frame contacts open instead, :mod:`.contact_switching`), a negative
+    normal force. Not the latter near a fold (``checks``: those of the state): there the normal
+    force of the vanishing point grows without bound either way, and the point is about to jump."""
     model = form.model
     parts = split_state(form, x, z)
     normal = -np.asarray(parts["lambda"])[form.normal_force_index()]
-    for e, n, check in zip(model.wheelrail, normal, checks):
+    releasable = form.releasable()  # these open instead (see contact_switching)
+    for k, (e, n, check) in enumerate(zip(model.wheelrail, normal, checks)):
         s = parts["s"][e.s_index : e.s_index + 4]
         try:
             e.contact.frames.check(s[2])
@@ -267,13 +268,13 @@ def lost_contact(form, x, z, checks) -> str | None:
                 return (f"the {e.joint.name} contact point left the {label} profile {prof.name!r} (at "
                         f"{value * 1e3:.2f} mm of {prof.s_min * 1e3:.2f} to {prof.s_max * 1e3:.2f} mm): the wheel has run "
                         "off its rail")
-        if n < 0 and check.curvature_per_m >= FOLD_CURVATURE_PER_M:
-            return (f"{e.joint.name} lifts off its rail (normal force {n / 1e3:.3g} kN): the constraint contact "
-                    "cannot separate")
+        if n < 0 and check.curvature_per_m >= FOLD_CURVATURE_PER_M and k not in releasable:
+            return (f"{e.joint.name} lifts off its rail (normal force {n / 1e3:.3g} kN): a contact in the global "
+                    "form (eq. 21) cannot separate; use form='railframe'")
     return None
 
 
-def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False):
+def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False, open_rows=()):
     """``(x, z, names)``: the state after moving every contact with a :meth:`ContactCheck.target`
     there (``names`` lists them; unchanged state and an empty list if none). ``checks`` are those
     of :func:`check_contacts` at this state (computed if not given)."""
@@ -302,5 +303,5 @@ def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False):
     # gap differs from the old one's by the margin only (both carry the same constraint drift,
     # which the Baumgarte terms remove). Projecting them onto C = 0 would shift and roll the
     # wheelset by that drift (micrometres at speed), enough to reorder minima nanometres apart.
-    x_new, z_new = consistent_state(form, t, start=start, positions=False)
+    x_new, z_new = consistent_state(form, t, start=start, positions=False, open_rows=open_rows)
     return x_new, z_new, jumped

@@ -5,7 +5,8 @@ The calls are many (hundreds per simulated second while a contact point crosses 
 conformal region) and building an integrator costs about as much as a short call, so the call
 lengths are binary fractions ``dt / 2^k`` of the output interval, aligned so that they add up
 to it exactly, and one integrator per ``k`` serves all calls of that length. IDAS finds the
-consistent ``x_dot`` itself at each start (``calc_ic``: exact for the semi-explicit DAE).
+consistent ``x_dot`` itself at each start (``calc_ic``: exact for the semi-explicit DAE; where
+that fails, see :meth:`ContactStepper._fallback`).
 (An integrator in normalized time ``tau = (t - t_a) / h`` would serve every length, but IDAS
 then takes a hundred times longer to give up at a fold.)
 """
@@ -18,6 +19,7 @@ import numpy as np
 
 from ..errors import ParameterError, SolverError
 from .contact_jumps import MIN_SPAN_S, check_contacts, jump_contacts, lost_contact
+from .contact_switching import Switching
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
@@ -47,21 +49,30 @@ class ContactStepper:
         The consistent initial state.
     stats : dict
         Summed IDAS statistics (``stat_keys``) and the counts ``contact_jumps``,
-        ``contact_calls`` and ``contact_retries``.
+        ``contact_calls``, ``contact_retries``, ``contact_fallbacks``, ``lift_offs`` and
+        ``touchdowns``.
+    open_flags : ndarray, optional
+        Contacts open at the start (:func:`.contact_switching.initial_open`); default none.
     """
 
-    def __init__(self, form, dae_fn, opts: dict, x, z, stats: dict, stat_keys=()):
+    def __init__(self, form, dae_fn, opts: dict, x, z, stats: dict, stat_keys=(), open_flags=None):
         self.form = form
         self.stats = stats
         self.stat_keys = stat_keys
-        for key in ("contact_jumps", "contact_calls", "contact_retries"):
+        for key in ("contact_jumps", "contact_calls", "contact_retries", "contact_fallbacks", "lift_offs",
+                    "touchdowns"):
             stats.setdefault(key, 0)
-        self.opts = {**{k: v for k, v in opts.items() if k != "init_xdot"}, "calc_ic": True}
+        self.switching = Switching(form, np.zeros(len(form.model.wheelrail)) if open_flags is None else open_flags)
+        # IDAS's own messages on calls the driver retries would only alarm (failures it cannot
+        # recover from are reported with the time and the worst residual).
+        self.opts = {**{k: v for k, v in opts.items() if k != "init_xdot"}, "calc_ic": True,
+                     "disable_internal_warnings": True}
         # A call is at most one output interval: this many steps mean a singularity (a fold
         # passed unnoticed), and the retry, shorter and after a jump check, beats waiting.
         self.opts["max_num_steps"] = min(int(opts.get("max_num_steps", MAX_CALL_STEPS)), MAX_CALL_STEPS)
         self.set_dae(dae_fn)
-        self.span = min(c.span_s() for c in check_contacts(form, x, z))
+        self.checks = check_contacts(form, x, z)
+        self.span = min(min(c.span_s() for c in self.checks), self.switching.span_s(0.0, z, self.checks))
 
     def set_dae(self, dae_fn) -> None:
         """Use ``dae_fn`` from now on (e.g. after a window moved)."""
@@ -74,21 +85,49 @@ class ContactStepper:
         integ = self._integrators.get(key)
         if integ is None:
             integ = self._integrators[key] = ca.integrator("idas", "idas", self.dae_fn, 0.0, [h], self.opts)
-        out = integ(x0=x, z0=z, p=t_a)
+        p = np.r_[t_a, self.switching.open]
+        try:
+            out = integ(x0=x, z0=z, p=p)
+        except RuntimeError as exc:
+            integ, out = self._fallback(x, z, p, h, exc)
         st = integ.stats()
         for k in self.stat_keys:
             self.stats[k] += int(st.get(k, 0))
         return np.asarray(out["xf"])[:, -1], np.asarray(out["zf"])[:, -1]
 
+    def _fallback(self, x, z, p, h, exc):
+        """The call once more, from the DAE's own ``x_dot`` instead of IDACalcIC (with GGL's
+        position rows, which hold no algebraic unknown, its Newton matrix is singular and may
+        fail on a state consistent to the tolerance), then with the LU solver (IDAS's first
+        steps of a microsecond call have ``cj = 1/h`` near 1e7, where the QR solver of the GGL
+        form has failed on consistent states). Uncached integrators: this is rare."""
+        x_dot = np.asarray(self.dae_fn(0.0, x, z, p, ca.DM(0, 1))[0]).ravel()
+        solvers = [self.opts.get("linear_solver")] if "IDACalcIC" in str(exc) else []
+        solvers += [s for s in ("csparse",) if s not in solvers]
+        for solver in solvers:
+            self.stats["contact_fallbacks"] += 1
+            opts = {**self.opts, "calc_ic": False, "init_xdot": x_dot.tolist(), "linear_solver": solver}
+            integ = ca.integrator("idas", "idas", self.dae_fn, 0.0, [h], opts)
+            try:
+                return integ, integ(x0=x, z0=z, p=p)
+            except RuntimeError as err:
+                exc = err
+        raise exc
+
     def _after(self, x, z, t, relaxed=False):
         checks = check_contacts(self.form, x, z)
-        x, z, jumped = jump_contacts(self.form, x, z, t, checks, relaxed)
+        x, z, jumped = jump_contacts(self.form, x, z, t, checks, relaxed, open_rows=self.switching.open_rows())
         if jumped:
             self.stats["contact_jumps"] += len(jumped)
             checks = check_contacts(self.form, x, z)
-        self.span = min(c.span_s() for c in checks)
+        x, z, switched = self.switching.update(x, z, t, checks)
+        if switched:
+            for s in switched:
+                self.stats["lift_offs" if s.kind == "lift-off" else "touchdowns"] += 1
+            checks = check_contacts(self.form, x, z)
+        self.span = min(min(c.span_s() for c in checks), self.switching.span_s(t, z, checks))
         self.checks = checks
-        return x, z, jumped
+        return x, z, jumped + [s.name for s in switched]
 
     def advance(self, x, z, t0: float, t1: float):
         """State at ``t1`` from ``(x, z)`` at ``t0``, with the contacts checked after every call.

@@ -15,14 +15,15 @@ def split_state(form, x, z) -> dict:
     return out
 
 
-def failure(form, exc, t, x, z, dae_fn, dt) -> SolverError:
+def failure(form, exc, t, x, z, dae_fn, dt, open_flags=()) -> SolverError:
     """Explain an IDAS failure: time, IDAS's reason, the largest algebraic residual (by name) of
     the last accepted state pushed one output step ahead along its derivative, and constraint
-    rows that have become nearly dependent."""
+    rows that have become nearly dependent. ``open_flags``: the wheel/rail contacts lifted off."""
     reason = str(exc).strip().splitlines()[-1] if str(exc).strip() else repr(exc)
     nil = ca.DM(0, 1)
-    x_dot = np.asarray(dae_fn(0.0, x, z, t, nil)[0]).ravel()
-    res = np.abs(np.asarray(dae_fn(dt, x + dt * x_dot, z, t, nil)[1]).ravel())
+    p = np.r_[t, open_flags]
+    x_dot = np.asarray(dae_fn(0.0, x, z, p, nil)[0]).ravel()
+    res = np.abs(np.asarray(dae_fn(dt, x + dt * x_dot, z, p, nil)[1]).ravel())
     names = form.residual_names()
     worst = names[int(np.argmax(res))] if res.size else "none"
     message = (f"IDAS failed in the step after t = {t:.6g} s: {reason}. Largest algebraic residual one "

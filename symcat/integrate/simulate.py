@@ -23,6 +23,7 @@ from ..assembly.sparse import to_scipy
 from ..dae.initial import CreepCoupling, consistent_state, kkt_solve
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
+from .contact_switching import initial_open
 from .contact_stepping import CallFailed, ContactStepper
 from .failure import failure, split_state
 
@@ -62,7 +63,10 @@ class SimulationResult:
     wheelrail : dict
         Wheel/rail contact name -> histories: ``normal_force_N`` (n_t,), the surface parameters
         ``s`` (n_t, 4: s1w m, s2w rad, s1r m, s2r m), ``xi_x``, ``xi_y`` (-), ``phi_per_m``
-        (spin, 1/m) and the creep forces ``fx_N``, ``fy_N``, ``mz_Nm`` (zero without creep).
+        (spin, 1/m), the creep forces ``fx_N``, ``fy_N``, ``mz_Nm`` (zero without creep), the
+        normal gap ``gap_m`` (> 0 separated; the constraint drift while in contact), ``open``
+        (bool: lifted off, see :mod:`.contact_switching`) and the times (s) of its lift-offs and
+        touchdowns, ``lift_off_s`` and ``touchdown_s``.
     """
 
     t_s: np.ndarray
@@ -149,7 +153,8 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     form = Formulation(model, formulation, index, baumgarte, cholesky)
     if linear_solver is None:
         linear_solver = "csparse" if form.index == "1" else "qr"
-    x, z = consistent_state(form, 0.0)
+    open_flags = initial_open(form) if model.wheelrail else np.zeros(0)
+    x, z = consistent_state(form, 0.0, open_rows=form.open_rows(open_flags))
     t_grid = np.linspace(0.0, t_end, n_out + 1)
     fixed_edges = None
     if chunks:
@@ -163,6 +168,8 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     if max_step:
         opts["max_step_size"] = max_step
     xs, zs = [x], [z]
+    opens = [open_flags.copy()]  # wheel/rail contacts lifted off, at each output
+    events = []                  # their lift-offs and touchdowns (contact_switching.Switch)
     stats = dict.fromkeys(STAT_KEYS, 0)
     stats["restarts"] = 0
     bar = Progress("simulate", t_end, "s", enabled=progress)
@@ -191,7 +198,8 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
         if model.wheelrail:
             # Short calls with contact checks between them (see contact_stepping).
             dae_fn = dae_function()
-            stepper = ContactStepper(form, dae_fn, opts, x, z, stats, STAT_KEYS)
+            stepper = ContactStepper(form, dae_fn, opts, x, z, stats, STAT_KEYS, open_flags)
+            events = stepper.switching.events
             for a in range(n_out):
                 if _update_windows(model, form, x, z):
                     stats["restarts"] += 1
@@ -199,9 +207,11 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
                 try:
                     x, z = stepper.advance(x, z, t_grid[a], t_grid[a + 1])
                 except CallFailed as exc:
-                    raise failure(form, exc.error, exc.t, exc.x, exc.z, stepper.dae_fn, t_grid[a + 1] - exc.t) from None
+                    raise failure(form, exc.error, exc.t, exc.x, exc.z, stepper.dae_fn, t_grid[a + 1] - exc.t,
+                                  stepper.switching.open) from None
                 xs.append(x)
                 zs.append(z)
+                opens.append(stepper.switching.open.copy())
                 done = a + 1
                 bar.update(t_grid[a + 1])
         a, limit = (n_out if model.wheelrail else 0), None
@@ -237,10 +247,10 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             a = b
     except SolverError as err:
         bar.close()
-        err.partial = _result(form, t_grid[: done + 1], xs, zs, stats, wall0)
+        err.partial = _result(form, t_grid[: done + 1], xs, zs, stats, wall0, opens, events)
         raise
     bar.close()
-    return _result(form, t_grid, xs, zs, stats, wall0)
+    return _result(form, t_grid, xs, zs, stats, wall0, opens, events)
 
 
 def _atol_vector(form, atol) -> list:
@@ -321,20 +331,20 @@ def _update_windows(model, form, x, z) -> bool:
     return moved
 
 
-def _result(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
+def _result(form: Formulation, t, xs, zs, stats, wall0, opens, events) -> SimulationResult:
     model = form.model
     # Post-processing sees the whole wire: the integration windows have moved on.
     saved = [sl.window for sl in model.windowed()]
     for sl in model.windowed():
         sl.window = (0, len(sl.element_start) - 1)
     try:
-        return _collect(form, t, xs, zs, stats, wall0)
+        return _collect(form, t, xs, zs, stats, wall0, opens, events)
     finally:
         for sl, w in zip(model.windowed(), saved):
             sl.window = w
 
 
-def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
+def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events) -> SimulationResult:
     model = form.model
     n_f, n_s = form.n_f, form.n_s
     parts = [split_state(form, x, z) for x, z in zip(xs, zs)]
@@ -367,6 +377,7 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
     s_dot = np.zeros((len(parts), n_s))
     normal_rows = [e.row_start + GAP_ROW for e in model.wheelrail]  # the gap rows (lam: augmented layout)
     creep_record = np.zeros((len(parts), 6 * len(model.wheelrail)))
+    wheel_gap = np.zeros((len(parts), len(model.wheelrail)))
     creep_fn = form.creep_function() if model.wheelrail else None
     pos, vel, kin, pot = (np.zeros(len(parts)) for _ in range(4))
     reactions = {name.split("[")[0]: np.zeros((len(parts), 3)) for name in model.row_names}
@@ -375,14 +386,26 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
         c, cdot, sd, cq, cs, mass, force, qd, gap, fc = drift(p["q"], p["v"], p["s"], w, ti, sc[i])
         gaps[i], contact_forces[i] = np.asarray(gap).ravel(), np.asarray(fc).ravel()
         s_dot[i] = np.asarray(sd).ravel()
-        pos[i] = np.abs(np.asarray(c)).max(initial=0.0)
-        vel[i] = np.abs(np.asarray(cdot)).max(initial=0.0)
+        closed = np.setdiff1d(np.arange(model.n_c), form.open_rows(opens[i]) if model.wheelrail else [])
+        c = np.asarray(c).ravel()
+        wheel_gap[i] = [c[e.row_start + GAP_ROW] if e.joint.form == "railframe"
+                        else e.contact.gap(q[i, e.rows], p["s"][e.s_index : e.s_index + 4]) for e in model.wheelrail]
+        pos[i] = np.abs(c[closed]).max(initial=0.0)
+        vel[i] = np.abs(np.asarray(cdot).ravel()[closed]).max(initial=0.0)
         # Multipliers from the KKT system at each output (exact for the state, whatever IDAS's
         # tolerance on algebraic variables): the same for every formulation.
         if model.n_c:
             creep = CreepCoupling(form, p["q"], p["v"], p["s"], s_dot[i], normal_rows)
-            mass_i, cq_i, cs_i, qd_i = to_scipy(mass), to_scipy(cq), np.asarray(ca.densify(cs)), np.asarray(qd).ravel()
-            a_i, _, lam[i] = creep.solve(lambda f: kkt_solve(mass_i, f, cq_i, cs_i, qd_i), np.asarray(force).ravel())
+            mass_i, cq_i = to_scipy(mass), to_scipy(cq).tocsr()[closed].tocsc()
+            cs_i, qd_i = np.asarray(ca.densify(cs))[closed], np.asarray(qd).ravel()[closed]
+
+            def kkt(f):
+                a_k, s_dd, lam_closed = kkt_solve(mass_i, f, cq_i, cs_i, qd_i)
+                lam_k = np.zeros(model.n_c)
+                lam_k[closed] = lam_closed  # lifted-off contacts carry no force
+                return a_k, s_dd, lam_k
+
+            a_i, _, lam[i] = creep.solve(kkt, np.asarray(force).ravel())
             if creep.active:
                 creep_record[i] = np.asarray(creep_fn(p["q"], p["v"], p["s"], s_dot[i], -lam[i][normal_rows])[1]).ravel()
         else:
@@ -401,6 +424,9 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0) -> SimulationResult:
         contacts={ct.joint.name: {"s_m": sc[:, k], "gap_m": gaps[:, k], "force_N": contact_forces[:, k]}
                   for k, ct in enumerate(model.contacts)},
         wheelrail={e.joint.name: {"normal_force_N": _normal_force(e, lam), "s": s[:, e.s_index : e.s_index + 4],
+                                  "gap_m": wheel_gap[:, k], "open": np.array([o[k] for o in opens], bool),
+                                  **{f"{kind.replace('-', '_')}_s": np.array([ev.t_s for ev in events if ev.name == e.joint.name
+                                                                              and ev.kind == kind]) for kind in ("lift-off", "touchdown")},
                                   **{name: creep_record[:, 6 * k + j] for j, name in
                                      enumerate(("xi_x", "xi_y", "phi_per_m", "fx_N", "fy_N", "mz_Nm"))}}
                    for k, e in enumerate(model.wheelrail)},
