@@ -37,7 +37,7 @@ from ..assembly.multibody import MultibodyModel
 from ..assembly.sparse import to_scipy
 from ..dae.formulation import Formulation
 from ..errors import SolverError
-from ..integrate.simulate import _reactions
+from ..integrate.results import _reactions
 
 
 @dataclass
