@@ -114,18 +114,8 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     x0 = np.zeros(sum(b.size for b in xb.values()))
     z0 = np.zeros(sum(b.size for b in zb.values()))
     creep = CreepCoupling(form, q, v, s, w)
-    def scatter(lam_closed, rows):
-        """Multipliers of ``rows`` (model numbering) from those of the closed ones (open: 0)."""
-        full = np.zeros(form.n_c)
-        full[closed] = lam_closed
-        return full[rows]
-
     if form.formulation == "augmented":
-        def augmented(force):
-            a, s_dd, lam = kkt_solve(m, force, cq, cs, qd)
-            return a, s_dd, scatter(lam, np.arange(form.n_c))
-
-        a, s_dd, lam = creep.solve(augmented, f)
+        a, s_dd, lam = creep.solve(lambda force: kkt_solve_closed(m, force, cq, cs, qd, closed, form.n_c), f)
         values_x = {"q": q, "s": s, "v": v, "w": w}
         values_z = {"a": a, "s_dd": s_dd, "w": w, "lambda": lam, "mu": np.zeros(form.n_c), "sc": sc}
     else:
@@ -185,6 +175,16 @@ class CreepCoupling:
             normal = new
         raise SolverError(f"creep forces and normal forces did not settle in {max_iterations} passes "
                           f"(normal forces {np.array2string(new, precision=4)} N)")
+
+
+def kkt_solve_closed(m, f, cq, cs, qd, closed, n_c: int):
+    """:func:`kkt_solve` with only the ``closed`` constraint rows (``cq``, ``cs``, ``qd`` are
+    theirs); the multipliers come back for all ``n_c`` rows, zero on the open ones (lifted-off
+    wheel/rail contacts carry no force)."""
+    a, s_dd, lam_closed = kkt_solve(m, f, cq, cs, qd)
+    lam = np.zeros(n_c)
+    lam[closed] = lam_closed
+    return a, s_dd, lam
 
 
 def kkt_solve(m, f, cq, cs, qd):

@@ -43,7 +43,7 @@ import numpy as np
 from ..assembly.wheelrail import GAP_ROW, TANGENCY_ROWS
 from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
-from .failure import split_state
+from .failure import restart_point, split_state
 
 #: A minimum this much below the followed point (m) triggers a jump.
 JUMP_TOLERANCE_M = 1e-9
@@ -297,8 +297,7 @@ def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False, open
         jumped.append(e.joint.name)
     if not jumped:
         return x, z, []
-    start = {"q": parts["q"], "v": parts["v"], "s": s, "w": parts.get("w", np.zeros(form.n_s)),
-             "sc": parts.get("sc", np.zeros(form.n_sc))}
+    start = restart_point(form, parts, s)
     # Positions stay: the new point is an exact stationary point of the gap at them, and its
     # gap differs from the old one's by the margin only (both carry the same constraint drift,
     # which the Baumgarte terms remove). Projecting them onto C = 0 would shift and roll the

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..dae.initial import consistent_state
 from .contact_jumps import FOLD_CURVATURE_PER_M, MIN_SPAN_S
-from .failure import split_state
+from .failure import restart_point, split_state
 
 #: A contact whose gap exceeds this at the start (m) starts open (a wheelset dropped on its rails).
 INITIAL_OPEN_GAP_M = 1e-5
@@ -126,8 +126,7 @@ class Switching:
         self._last = None
         touchdown = any(s.kind == "touchdown" for s in switches)
         parts = split_state(self.form, x, z)
-        start = {"q": parts["q"], "v": parts["v"], "s": parts["s"], "w": parts.get("w", np.zeros(self.form.n_s)),
-                 "sc": parts.get("sc", np.zeros(self.form.n_sc))}
+        start = restart_point(self.form, parts)
         # A touchdown is a plastic impact at the touching point (positions onto C = 0, velocities
         # by the impulse); a lift-off changes only the accelerations and multipliers.
         x, z = consistent_state(self.form, t, start=start, positions=touchdown, open_rows=self.open_rows(),

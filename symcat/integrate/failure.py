@@ -15,6 +15,13 @@ def split_state(form, x, z) -> dict:
     return out
 
 
+def restart_point(form, parts: dict, s=None) -> dict:
+    """``start`` for :func:`symcat.dae.initial.consistent_state` from a split state (``s``
+    replaces the surface parameters, e.g. after a contact jump)."""
+    return {"q": parts["q"], "v": parts["v"], "s": parts["s"] if s is None else s,
+            "w": parts.get("w", np.zeros(form.n_s)), "sc": parts.get("sc", np.zeros(form.n_sc))}
+
+
 def failure(form, exc, t, x, z, dae_fn, dt, open_flags=()) -> SolverError:
     """Explain an IDAS failure: time, IDAS's reason, the largest algebraic residual (by name) of
     the last accepted state pushed one output step ahead along its derivative, and constraint
