@@ -275,7 +275,8 @@ def _add_bogie(scene, layout, site, p, loads, bogie, xb, y0, v, dims, creep_mode
     axes = site.bushing_axes
     # Bolster on the frame: secondary suspension per side, anti-roll bar at the centre.
     for side, ys in zip(SIDES, (a, -a)):
-        scene.add(Bushing(f"{bogie}_secondary_{side}", frame, bolster, at=site.point((xb, y0 + ys, p.secondary_height_m)),
+        scene.add(Bushing(f"{bogie}_secondary_{side}", frame, bolster,
+                          at=site.point((xb, y0 + ys, p.secondary_height_m)),
                           stiffness=p.secondary_stiffness_N_m, damping=p.secondary_damping_N_s_m,
                           preload=tuple(loads["secondary"] * up), clearance=(0.0, p.bump_stop_clearance_m, 0.0),
                           stop_stiffness=(0.0, p.bump_stop_stiffness_N_m, 0.0), axes=axes))
@@ -333,6 +334,7 @@ def _add_bogie(scene, layout, site, p, loads, bogie, xb, y0, v, dims, creep_mode
                               stiffness=(0.0, 0.0, p.primary_stiffness_N_m[2]), damping=(0.0, 0.0, cz),
                               preload=(0.0, 0.0, loads["equalizer_spring"]), axes=axes))
         g = p.equalizer_guide_stiffness_N_m
-        scene.add(Bushing(f"{bogie}_equalizer_guide_{side}", frame, eq, at=site.point((xb, y0 + ys, p.equalizer_height_m)),
+        scene.add(Bushing(f"{bogie}_equalizer_guide_{side}", frame, eq,
+                          at=site.point((xb, y0 + ys, p.equalizer_height_m)),
                           stiffness=(g, g, 0.0), rotational_stiffness=(p.equalizer_roll_stiffness_N_m_rad, 0.0, 0.0),
                           rotational_damping=(p.equalizer_roll_damping_N_m_s_rad, 0.0, 0.0), axes=axes))

@@ -60,8 +60,8 @@ def test_a_start_off_the_lead_in_or_a_driving_constraint_in_a_curve_is_refused(p
 def test_contact_frames_on_a_canted_curve_are_the_track_frames(pair):
     """The creep direction ``t1`` and the axes of Y and Q at contacts in a transition and in a
     canted curve: the rail tangent and the canted track frame of the layout's exact frames
-    (the kernels' are cubic pieces), a right-handed frame whose lateral axis is horizontal up to
-    the cant and normal to the centre line."""
+    (the kernels' are cubic pieces): the lateral axis normal to the centre line and tilted by
+    the cant angle."""
     track, _ = curve_track(pair, 300.0, cant_m=0.12, transition_length_m=20.0, curve_length_m=40.0,
                            direction="right")
     layout = VehicleLayout(pair=pair, track=track)
