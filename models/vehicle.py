@@ -1,5 +1,5 @@
-"""The seed paper's railroad vehicle (Figures 8 and 9) on tangent track with constraint
-wheel/rail contact.
+"""The seed paper's railroad vehicle (Figures 8 and 9) on tangent track or into a curve, with
+constraint wheel/rail contact.
 
 A car body on two bogies; each bogie has a frame, a bolster, two equalizer bars and two
 wheelsets (:mod:`symcat.vehicle`: Manchester benchmark vehicle 1 with documented, assumed values
@@ -7,6 +7,15 @@ for the bolsters and equalizer bars), eight wheel/rail contacts by the constrain
 (seed eq. 22) with creep forces, and the leading wheelset of each bogie driven at ``speed_ms``
 (a driving constraint, as in the seed paper, or a traction servo). The vehicle starts in static
 equilibrium, displaced ``lateral_offset_m`` toward the left rail, and runs for ``t_end``.
+
+With ``curve_radius_m > 0`` the track (:func:`symcat.vehicle.curve_track`) is a tangent lead-in
+holding the whole vehicle (its outermost wheelsets 1 m from its ends), a clothoid transition of
+``transition_length_m`` that ramps the curvature and the cant (``cant_m``, the outer rail's
+superelevation), and a circular curve of ``curve_radius_m`` to the ``curve_direction``, long
+enough for the run (``speed_ms * t_end + 10`` m). The driving constraint cannot follow a curve:
+``drive="auto"`` (default) is the seed paper's constraint on tangent track and the traction
+servo in a curve. A cant needs the index-1 form (``index="1"``): the ends of a cant ramp are
+kinks of the rails, crossed as impacts, which the GGL form does not carry over.
 
 Summary
 -------
@@ -21,9 +30,18 @@ Summary
 ``normal_force_min_N``, ``normal_force_max_N``
     Extremes of each wheel's normal force over the run (N).
 ``lateral_displacement_max_m``
-    Largest lateral displacement of each wheelset (m).
+    Largest lateral displacement of each wheelset from the track centre line (m, in the track
+    frame at its chainage).
 ``derailment_quotient_max``
-    Largest Y/Q of each wheel (lateral force toward the track centre over vertical force).
+    Largest Y/Q of each wheel (lateral force toward the track centre over vertical force, in
+    the track frame at the contact).
+``lateral_force_sum_N``
+    Net track-lateral force of the rails on the vehicle at the end of the run (N, toward the
+    left rail; each wheel's in the track frame at its contact).
+``lateral_force_quasi_static_N``
+    The same for steady curving, ``M (kappa v^2 cos phi + g sin phi)``, with the curvature and
+    cant angle at the rear wheelset and the car body's speed at the end (N; meaningful once the
+    whole vehicle is in the circular curve and settled; 0 on tangent track).
 ``wall_s``, ``simulated_s``, ``wall_per_simulated_s``, ``max_position_drift_m``
 """
 from __future__ import annotations
@@ -31,11 +49,12 @@ from __future__ import annotations
 import numpy as np
 
 from symcat.assembly.multibody import MultibodyModel
-from symcat.errors import SolverError
+from symcat.errors import ParameterError, SolverError
 from symcat.integrate import simulate
 from symcat.model import Model, ModelOutput, Parameter
 from symcat.scene import Scene
-from symcat.vehicle import DRIVES, VehicleParameters, add_vehicle, wheel_forces
+from symcat.vehicle import (DRIVES, VehicleParameters, add_vehicle, curve_track, lateral_displacement_m,
+                            lateral_force_sum_N, steady_curving_forces_N, wheel_forces)
 from symcat.wheelrail import PAIR_NAMES, profile_pair
 
 G = 9.81
@@ -48,9 +67,17 @@ PARAMETERS = [
     Parameter("creep", "linear", "", "creep forces", choices=("none", "linear", "nonlinear")),
     Parameter("friction_coefficient", 0.3, "-", "friction coefficient of the nonlinear law", minimum=0.0, maximum=1.0,
               exclusive_minimum=True),
-    Parameter("drive", "constraint", "", "leading wheelsets: driving constraint or traction servo", choices=DRIVES),
+    Parameter("drive", "auto", "", "leading wheelsets: driving constraint or traction servo (auto: the constraint on "
+              "tangent track, the servo in a curve)", choices=("auto",) + DRIVES),
     Parameter("lateral_offset_m", 0.002, "m", "initial lateral displacement toward the left rail", minimum=-0.008,
               maximum=0.008),
+    Parameter("curve_radius_m", 0.0, "m", "radius of the circular curve after the lead-in; 0: tangent track",
+              minimum=0.0),
+    Parameter("curve_direction", "left", "", "side of the curve centre", choices=("left", "right")),
+    Parameter("cant_m", 0.0, "m", "superelevation of the outer rail in the curve (needs a transition)", minimum=0.0,
+              maximum=0.2),
+    Parameter("transition_length_m", 20.0, "m", "clothoid transition ramping curvature and cant into the curve",
+              minimum=0.0),
     Parameter("t_end", 1.0, "s", "simulated time", minimum=0.0, exclusive_minimum=True),
     Parameter("index", "ggl", "", "constraint stabilization: GGL (positions held) or index 1 with Baumgarte",
               choices=("ggl", "1")),
@@ -59,14 +86,42 @@ PARAMETERS = [
 ]
 
 
+def track_for(p: dict, pair, parameters: VehicleParameters):
+    """The track layout and the vehicle's start chainage (m) for parameters ``p``: ``(None,
+    0.0)`` (tangent track) unless ``curve_radius_m > 0``."""
+    if p.get("curve_radius_m", 0.0) <= 0:
+        if p.get("cant_m", 0.0) > 0:
+            raise ParameterError(f"cant_m={p['cant_m']:g}: a cant needs a curve (curve_radius_m > 0)")
+        return None, 0.0
+    return curve_track(pair, p["curve_radius_m"], cant_m=p["cant_m"], transition_length_m=p["transition_length_m"],
+                       curve_length_m=p["speed_ms"] * p["t_end"] + 10.0, direction=p["curve_direction"],
+                       parameters=parameters)
+
+
 def build(p: dict):
     """Scene, layout and assembled model for parameters ``p``."""
     scene = Scene(gravity=(0.0, 0.0, -G))
-    layout = add_vehicle(scene, profile_pair(p["profile"], p["conicity"]), speed_ms=p["speed_ms"],
-                         creep={"nonlinear": "polach"}.get(p["creep"], p["creep"]),
-                         friction_coefficient=p["friction_coefficient"], drive=p["drive"],
-                         lateral_offset_m=p["lateral_offset_m"], parameters=VehicleParameters())
+    pair = profile_pair(p["profile"], p["conicity"])
+    parameters = VehicleParameters()
+    track, x_m = track_for(p, pair, parameters)
+    drive = p["drive"] if p["drive"] != "auto" else ("constraint" if track is None else "torque")
+    layout = add_vehicle(scene, pair, speed_ms=p["speed_ms"], creep={"nonlinear": "polach"}.get(p["creep"], p["creep"]),
+                         friction_coefficient=p["friction_coefficient"], drive=drive,
+                         lateral_offset_m=p["lateral_offset_m"], parameters=parameters, track=track, x_m=x_m)
     return scene, layout, MultibodyModel(scene)
+
+
+def quasi_static_lateral_force_N(res, layout) -> float:
+    """Steady-curving lateral force sum (N) at the end of the run: curvature and cant angle at
+    the rear wheelset's chainage, the car body's speed (:func:`steady_curving_forces_N`)."""
+    if layout.track is None:
+        return 0.0
+    rear = layout.contacts[layout.wheelsets[-1]]
+    s = float(np.mean([res.wheelrail[rear[side]]["s"][-1, 2] for side in rear]))
+    i = res.coordinate_names.index(f"{layout.car_body}.x")
+    speed = float(np.linalg.norm(res.v[-1, i : i + 3]))
+    kappa, phi = float(layout.track.curvature(s)[0]), float(layout.track.cant_angle(s)[0])
+    return steady_curving_forces_N(layout.parameters.total_mass_kg, speed, kappa, phi)[0]
 
 
 def summarize(res, layout) -> dict:
@@ -82,8 +137,10 @@ def summarize(res, layout) -> dict:
         "vertical_force_static_sum_N": float(sum(forces[n]["Q_N"][0] for n in names)),
         "normal_force_min_N": [float(forces[n]["normal_N"].min()) for n in names],
         "normal_force_max_N": [float(forces[n]["normal_N"].max()) for n in names],
-        "lateral_displacement_max_m": [float(np.abs(res.coordinate(f"{w}.y")).max()) for w in layout.wheelsets],
+        "lateral_displacement_max_m": [float(np.abs(y).max()) for y in lateral_displacement_m(res, layout).values()],
         "derailment_quotient_max": yq,
+        "lateral_force_sum_N": float(lateral_force_sum_N(forces)[-1]),
+        "lateral_force_quasi_static_N": quasi_static_lateral_force_N(res, layout),
         "wall_s": float(res.stats["wall_s"]),
         "simulated_s": float(res.t_s[-1]),
         "wall_per_simulated_s": float(res.stats["wall_s"] / max(res.t_s[-1], 1e-12)),
@@ -97,7 +154,8 @@ def run(p: dict) -> ModelOutput:
         res = simulate(model, p["t_end"], index=p["index"], rtol=p["rtol"], n_out=int(p["n_out"]),
                        progress=p.get("progress", True))
     except SolverError as err:
-        raise SolverError(f"{err} (vehicle model: try index=ggl or a tighter rtol; a flange contact or a contact "
+        hint = "; in a canted curve index=1 (the cant ramps' ends are impacts)" if p.get("cant_m", 0.0) > 0 else ""
+        raise SolverError(f"{err} (vehicle model: try index=ggl or a tighter rtol{hint}; a flange contact or a contact "
                           "jump may have been reached)") from err
     summary = summarize(res, layout)
     stats = {k: res.stats[k] for k in ("nsteps", "nfevals", "netfails", "nncfails", "restarts")}
@@ -111,10 +169,11 @@ def run(p: dict) -> ModelOutput:
         res.save(out / "vehicle.npz")
         forces = wheel_forces(res, layout)
         fig, axes = plt.subplots(3, 1, figsize=(8, 9), sharex=True)
-        for w in layout.wheelsets:
-            axes[0].plot(res.t_s, res.coordinate(f"{w}.y") * 1e3, lw=1, label=w)
+        for w, y in lateral_displacement_m(res, layout).items():
+            axes[0].plot(res.t_s, y * 1e3, lw=1, label=w)
         axes[0].set_ylabel("wheelset lateral [mm]")
-        axes[0].set_title(f"vehicle, {p['profile']}, {p['speed_ms']:g} m/s, creep {p['creep']}", fontsize=9)
+        where = f", curve R {p['curve_radius_m']:g} m, cant {p['cant_m'] * 1e3:g} mm" if layout.track else ""
+        axes[0].set_title(f"vehicle, {p['profile']}, {p['speed_ms']:g} m/s, creep {p['creep']}{where}", fontsize=9)
         for n in layout.contact_names:
             axes[1].plot(res.t_s, forces[n]["normal_N"] / 1e3, lw=1, label=n)
             axes[2].plot(res.t_s, forces[n]["Y_over_Q"], lw=1, label=n)

@@ -1,7 +1,10 @@
 """The seed paper's railroad vehicle: car body, two bogies (frame, bolster, two equalizer bars,
-two wheelsets), suspensions and wheel/rail contacts."""
-from .builder import BOGIES, DRIVES, SIDES, WHEELSETS, VehicleLayout, add_vehicle
+two wheelsets), suspensions and wheel/rail contacts, on tangent track or on a track layout."""
+from .builder import BOGIES, DRIVES, SIDES, WHEELSETS, VehicleLayout, add_vehicle, check_start_on_tangent
+from .curving import curve_track, steady_curving_forces_N
 from .parameters import VehicleParameters
-from .wheel_forces import wheel_forces
+from .wheel_forces import lateral_displacement_m, lateral_force_sum_N, wheel_forces
 
-__all__ = ["BOGIES", "DRIVES", "SIDES", "WHEELSETS", "VehicleLayout", "VehicleParameters", "add_vehicle", "wheel_forces"]
+__all__ = ["BOGIES", "DRIVES", "SIDES", "WHEELSETS", "VehicleLayout", "VehicleParameters", "add_vehicle",
+           "check_start_on_tangent", "curve_track", "lateral_displacement_m", "lateral_force_sum_N",
+           "steady_curving_forces_N", "wheel_forces"]
