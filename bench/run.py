@@ -225,6 +225,10 @@ def main():
     from bench.vehicle import section as vehicle_section
 
     vehicle = vehicle_section(REPORT)
+    print("compiled model DAE ...", flush=True)
+    from bench.model_dae import section as model_dae_section
+
+    model_dae = model_dae_section(REPORT)
     lines = [
         "# symcat benchmark report",
         "",
@@ -287,6 +291,7 @@ def main():
         "",
         *wheelset,
         *vehicle,
+        *model_dae,
     ]
     (REPORT / "README.md").write_text("\n".join(lines))
     print(f"wrote {REPORT / 'README.md'}")

@@ -14,6 +14,7 @@ import os
 import shutil
 import subprocess
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -50,18 +51,26 @@ def _compiler_identity(path: str) -> str:
     return f"{path}:{st.st_size}:{int(st.st_mtime)}"
 
 
-def compile_c(c_path: Path, name: str) -> Path:
-    """Compile ``c_path`` into the cache (if not there yet) and return the library path."""
+def cached_library(name: str, key_source: bytes, flags: tuple = CFLAGS) -> Path:
+    """Where the library compiled from C identified by ``key_source`` lives in the cache
+    (whether or not it is there yet): ``<cache>/<name>-<key>.so``."""
     compiler = find_compiler()
-    key = hashlib.sha256(
-        c_path.read_bytes() + _compiler_identity(compiler).encode() + " ".join(CFLAGS).encode()
-    ).hexdigest()[:20]
-    target = cache_dir() / f"{name}-{key}.so"
+    key = hashlib.sha256(key_source + _compiler_identity(compiler).encode() + " ".join(flags).encode()).hexdigest()[:20]
+    return cache_dir() / f"{name}-{key}.so"
+
+
+def compile_c(c_path: Path, name: str, flags: tuple = CFLAGS, key_source: bytes | None = None) -> Path:
+    """Compile ``c_path`` into the cache (if not there yet) and return the library path.
+    ``key_source``: what identifies the C text, if not the text itself (the caller then
+    writes ``c_path`` only when the returned library does not exist yet: see
+    :func:`cached_library`)."""
+    target = cached_library(name, c_path.read_bytes() if key_source is None else key_source, flags)
     if target.exists():
         return target
+    compiler = find_compiler()
     target.parent.mkdir(parents=True, exist_ok=True)
     tmp = target.with_name(f".{target.name}.{os.getpid()}.{time.monotonic_ns()}.tmp")
-    cmd = [compiler, *CFLAGS, str(c_path), "-o", str(tmp), "-lm"]
+    cmd = [compiler, *flags, str(c_path), "-o", str(tmp), "-lm"]
     log.info("compiling %s", c_path.name)
     COMPILE_COUNT["n"] += 1
     try:
@@ -110,8 +119,39 @@ def ensure_generated(name: str) -> Path:
     return path
 
 
+class SymbolicKernelLibrary(KernelLibrary):
+    """A kernel library as CasADi SX functions, derived from its symbolic sources (imports
+    SymPy): a graph built from them expands into one SX function (see :func:`symbolic_kernels`)."""
+
+    def __getitem__(self, function: str) -> ca.Function:
+        if not self.functions:
+            from .kernels import library_functions  # deferred: imports SymPy
+
+            self.functions.update((f.name(), f) for f in library_functions(self.name))
+        return self.functions[function]
+
+
+_SYMBOLIC: dict[str, SymbolicKernelLibrary] = {}
+_SYMBOLIC_DEPTH = [0]
+
+
+@contextmanager
+def symbolic_kernels():
+    """Within this context :func:`kernel_library` gives the kernels as SX functions instead of
+    compiled externals, so that a model graph built there can be expanded to SX, differentiated
+    and compiled as a whole (:mod:`symcat.codegen.model_dae`)."""
+    _SYMBOLIC_DEPTH[0] += 1
+    try:
+        yield
+    finally:
+        _SYMBOLIC_DEPTH[0] -= 1
+
+
 def kernel_library(name: str) -> KernelLibrary:
-    """Load (compiling on first use) the kernel library ``name``."""
+    """Load (compiling on first use) the kernel library ``name``; inside
+    :func:`symbolic_kernels`, its SX form."""
+    if _SYMBOLIC_DEPTH[0]:
+        return _SYMBOLIC.setdefault(name, SymbolicKernelLibrary(name, generated_dir() / f"{name}.c"))
     lib = _LOADED.get(name)
     if lib is None:
         so = compile_c(ensure_generated(name), name)

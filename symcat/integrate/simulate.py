@@ -9,12 +9,14 @@ reason, the largest residual by name and the result up to the last completed chu
 """
 from __future__ import annotations
 
+import logging
 import time
 
 import casadi as ca
 import numpy as np
 
 from ..assembly.multibody import MultibodyModel
+from ..codegen.model_dae import compiled_dae
 from ..dae.formulation import Formulation
 from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
@@ -24,6 +26,8 @@ from .contact_stepping import CallFailed, ContactStepper
 from .failure import failure, split_state
 from .results import SimulationResult, collect_result
 
+log = logging.getLogger(__name__)
+
 STAT_KEYS = ("nsteps", "nfevals", "nlinsetups", "netfails", "nniters", "nncfails")
 
 
@@ -31,7 +35,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
              rtol: float = 1e-6, atol: float = 1e-8, n_out: int = 200, baumgarte: float = 10.0,
              chunks: int | None = None, max_step: float | None = None, progress: bool = True,
              algebraic_atol: float = 1e-3, max_steps: int = 500000, cholesky: bool = False,
-             linear_solver: str | None = None) -> SimulationResult:
+             linear_solver: str | None = None, compiled: bool | None = None) -> SimulationResult:
     """Simulate ``model`` from 0 to ``t_end`` seconds.
 
     Parameters
@@ -67,6 +71,13 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
         faster than CasADi's default ``qr`` on a 32-element wire, see the benchmark), ``qr``
         (sparse QR) or ``lapacklu`` (dense LU). Default: ``csparse`` at index 1, ``qr`` for GGL,
         whose ill-conditioned index-2 matrices make the LU's pivoting fail (IDA_LSETUP_FAIL).
+    compiled : bool, optional
+        Compile the whole DAE residual and its Jacobian to C for this model
+        (:mod:`symcat.codegen.model_dae`; about 10 s for the seed vehicle the first time, then
+        cached), instead of evaluating CasADi's graph over the kernels. Default: for wheel/rail
+        models in the augmented form without element windows (those rebuild their DAE as the
+        windows move; the embedded form's linear solve does not expand, and a request for it
+        falls back to the graph with a warning).
     """
     if not t_end > 0:
         raise ParameterError(f"t_end={t_end}: must be > 0 s")
@@ -74,6 +85,9 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
         raise ParameterError(f"rtol={rtol}: must be in (0, 1)")
     wall0 = time.perf_counter()
     form = Formulation(model, formulation, index, baumgarte, cholesky)
+    if compiled is None:
+        # The embedded form's linear solve (an MX node) does not expand to SX.
+        compiled = bool(model.wheelrail) and not model.windowed() and formulation == "augmented"
     if linear_solver is None:
         linear_solver = "csparse" if form.index == "1" else "qr"
     open_flags = initial_open(form) if model.wheelrail else np.zeros(0)
@@ -111,11 +125,19 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             stats[k] += int(st.get(k, 0))
         return np.asarray(out["xf"]), np.asarray(out["zf"])
 
-    def dae_function():
+    def graph_dae():
         d = form.dae()
         # One Function per window: integrators built from it share its cached Jacobian.
         return ca.Function("dae", [d["t"], d["x"], d["z"], d["p"], ca.MX.sym("u", 0)],
                            [d["ode"], d["alg"], ca.MX(0, 1), ca.MX(0, 1)], ca.dyn_in(), ca.dyn_out())
+
+    def dae_function():
+        if compiled:
+            try:
+                return compiled_dae(graph_dae)
+            except RuntimeError as exc:  # a kernel outside the SX build: keep the graph
+                log.warning("the model's DAE could not be compiled (%s); evaluating its graph", exc)
+        return graph_dae()
 
     try:
         if model.wheelrail:

@@ -1,0 +1,73 @@
+"""One compiled C library per model: its whole DAE residual and the residual's Jacobian.
+
+IDAS spends most of a wheel/rail model's time in the Jacobian of the residual. Built as a
+CasADi MX graph over the compiled kernels (externals), that Jacobian is thousands of small
+sparse products run by CasADi's virtual machine: 4 to 8 ms for the seed vehicle (467 unknowns,
+7745 nonzeros). The same DAE built over the kernels' SX expressions (:func:`symbolic_kernels`),
+expanded to one SX function, differentiated in SX and compiled costs 0.3 ms, and its residual
+0.1 ms instead of 0.2 to 0.4 (``python -m bench.model_dae`` measures both). The library is
+cached under a key of the expanded function, so a model is compiled once per machine.
+"""
+from __future__ import annotations
+
+import logging
+import os
+import tempfile
+import time
+from pathlib import Path
+from typing import Callable
+
+import casadi as ca
+
+from .library import cached_library, compile_c, symbolic_kernels
+
+log = logging.getLogger(__name__)
+
+#: The code is straight-line arithmetic: -O1 triples the compile time (11 s -> 34 s for the
+#: vehicle) for 10 % faster evaluation (measured).
+FLAGS = ("-O0", "-fPIC", "-shared")
+
+#: Compilations of this process (the tests check that a second run makes none).
+COMPILED = {"n": 0, "seconds": 0.0}
+
+
+def compiled_dae(build: Callable[[], ca.Function]) -> ca.Function:
+    """The DAE function that ``build`` returns (an MX function over the kernels), as a compiled
+    external with its Jacobian companion ``jac_<name>``: same inputs, outputs and values.
+
+    ``build`` is called once as is (its serialization is the cache key) and, if the model is
+    not in the cache yet, once inside :func:`symbolic_kernels`: it must obtain every kernel
+    through :func:`symcat.codegen.library.kernel_library` while it runs.
+
+    Raises
+    ------
+    RuntimeError
+        If the graph cannot be expanded to SX (a kernel captured as an external outside
+        ``build``); the caller then keeps the MX function.
+    """
+    fn = build()
+    name = fn.name()
+    # The graph over the externals names each kernel library by its content-addressed path:
+    # its serialization identifies the model without deriving anything.
+    key = fn.serialize().encode()
+    library = cached_library(f"model_{name}", key, FLAGS)
+    if not library.exists():
+        t0 = time.perf_counter()
+        with symbolic_kernels():
+            sx = build().expand()
+        log.info("compiling the model's DAE (%d operations and their Jacobian)", sx.n_instructions())
+        jac = sx.jacobian()
+        with tempfile.TemporaryDirectory() as tmp:
+            cwd = os.getcwd()
+            os.chdir(tmp)  # CasADi writes relative to the working directory
+            try:
+                gen = ca.CodeGenerator(f"model_{name}.c", {"with_header": False, "verbose": False})
+                gen.add(sx)
+                gen.add(jac)
+                gen.generate()
+            finally:
+                os.chdir(cwd)
+            compile_c(Path(tmp) / f"model_{name}.c", f"model_{name}", FLAGS, key_source=key)
+        COMPILED["n"] += 1
+        COMPILED["seconds"] += time.perf_counter() - t0
+    return ca.external(name, str(library))
