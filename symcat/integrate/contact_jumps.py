@@ -56,6 +56,9 @@ OWN_RADIUS_M = 1e-5
 FOLD_CURVATURE_PER_M = 0.05
 #: Largest travel of a followed contact point along the wheel profile between two checks (m).
 TRAVEL_M = 5e-4
+#: A refused jump target (see :class:`.contact_stepping.ContactStepper`) covers the rivals this
+#: close to it along the wheel profile (m): it travels less in a refusal's hold.
+REFUSED_RADIUS_M = 1e-4
 #: Shortest integrator call (s): the floor of the predicted spans and of retries after a failure.
 MIN_SPAN_S = 1e-6
 
@@ -111,20 +114,25 @@ class ContactCheck:
         """Rival's gap minus the followed point's (m)."""
         return rival.point.gap_m - self.gap_m
 
-    def target(self, relaxed: bool = False) -> Rival | None:
+    def target(self, relaxed: bool = False, refused: float | None = None) -> Rival | None:
         """The rival to jump to, if any: the lowest formed one once it lies
         :data:`JUMP_TOLERANCE_M` below the followed point; or, when the followed point nears its
         fold, the lowest one not higher than that tolerance, formed ones first (in a flat valley
         of nearly conformal profiles the minima lie within a fraction of a nanometre, and the
         followed one is about to vanish); or, ``relaxed`` (IDAS has failed on the followed
-        point), the lowest one."""
-        formed = [r for r in self.rivals if r.formed]
+        point), the lowest one. ``refused``: the wheel parameter (m) of a point IDAS could not
+        integrate from just before; rivals within :data:`REFUSED_RADIUS_M` of it are not
+        targets unless ``relaxed``."""
+        rivals = self.rivals
+        if refused is not None and not relaxed:
+            rivals = [r for r in rivals if abs(r.point.s[0] - refused) > REFUSED_RADIUS_M]
+        formed = [r for r in rivals if r.formed]
         if formed and self.margin_m(formed[0]) < -JUMP_TOLERANCE_M:
             return formed[0]
         if relaxed:
-            return self.rivals[0] if self.rivals else None
+            return rivals[0] if rivals else None
         if self.curvature_per_m < FOLD_CURVATURE_PER_M:
-            level = [r for r in self.rivals if self.margin_m(r) < JUMP_TOLERANCE_M]
+            level = [r for r in rivals if self.margin_m(r) < JUMP_TOLERANCE_M]
             level.sort(key=lambda r: not r.formed)
             return level[0] if level else None
         return None
@@ -274,10 +282,12 @@ def lost_contact(form, x, z, checks) -> str | None:
     return None
 
 
-def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False, open_rows=()):
+def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False, open_rows=(), refused=None):
     """``(x, z, names)``: the state after moving every contact with a :meth:`ContactCheck.target`
     there (``names`` lists them; unchanged state and an empty list if none). ``checks`` are those
-    of :func:`check_contacts` at this state (computed if not given)."""
+    of :func:`check_contacts` at this state (computed if not given); ``refused``: contact name ->
+    wheel parameter (m) of a target to skip (:meth:`ContactCheck.target`)."""
+    refused = refused or {}
     model = form.model
     if not model.wheelrail:
         return x, z, []
@@ -286,7 +296,7 @@ def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False, open
     s = parts["s"].copy()
     jumped = []
     for e, c in zip(model.wheelrail, checks):
-        rival = c.target(relaxed)
+        rival = c.target(relaxed, refused.get(e.joint.name))
         if rival is None:
             continue
         i = e.s_index

@@ -4,9 +4,10 @@
 The calls are many (hundreds per simulated second while a contact point crosses a nearly
 conformal region) and building an integrator costs about as much as a short call, so the call
 lengths are binary fractions ``dt / 2^k`` of the output interval, aligned so that they add up
-to it exactly, and one integrator per ``k`` serves all calls of that length. IDAS finds the
-consistent ``x_dot`` itself at each start (``calc_ic``: exact for the semi-explicit DAE; where
-that fails, see :meth:`ContactStepper._fallback`).
+to it exactly, and (over CasADi's graph) one integrator per ``k`` serves all calls of that
+length, IDAS finding the consistent ``x_dot`` at each start (``calc_ic``). A compiled model DAE
+builds an integrator in 10 ms: each call then starts from the DAE's own ``x_dot``, which spares
+IDACalcIC (30 % of the wall time of an S1002 vehicle; see :meth:`ContactStepper.call`).
 (An integrator in normalized time ``tau = (t - t_a) / h`` would serve every length, but IDAS
 then takes a hundred times longer to give up at a fold.)
 """
@@ -20,11 +21,17 @@ import numpy as np
 from ..errors import ParameterError, SolverError
 from .contact_jumps import MIN_SPAN_S, check_contacts, jump_contacts, lost_contact
 from .contact_switching import Switching
+from .failure import split_state
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
 #: Relaxed jumps tried after consecutive failed calls from one state.
 RELAXED_JUMPS = 3
+#: How long (s) a jump target stays refused after IDAS failed from it (see ``advance``).
+REFUSAL_HOLD_S = 1e-3
+#: A run stalls when this many calls fail within :data:`STALL_SPAN_S` of simulated time.
+STALL_FAILURES = 60
+STALL_SPAN_S = 1e-4
 
 
 class CallFailed(RuntimeError):
@@ -49,8 +56,8 @@ class ContactStepper:
         The consistent initial state.
     stats : dict
         Summed IDAS statistics (``stat_keys``) and the counts ``contact_jumps``,
-        ``contact_calls``, ``contact_retries``, ``contact_fallbacks``, ``lift_offs`` and
-        ``touchdowns``.
+        ``contact_calls``, ``contact_retries``, ``contact_fallbacks``, ``contact_refusals``,
+        ``lift_offs`` and ``touchdowns``.
     open_flags : ndarray, optional
         Contacts open at the start (:func:`.contact_switching.initial_open`); default none.
     """
@@ -59,8 +66,8 @@ class ContactStepper:
         self.form = form
         self.stats = stats
         self.stat_keys = stat_keys
-        for key in ("contact_jumps", "contact_calls", "contact_retries", "contact_fallbacks", "lift_offs",
-                    "touchdowns"):
+        for key in ("contact_jumps", "contact_calls", "contact_retries", "contact_fallbacks", "contact_refusals",
+                    "lift_offs", "touchdowns"):
             stats.setdefault(key, 0)
         self.switching = Switching(form, np.zeros(len(form.model.wheelrail)) if open_flags is None else open_flags)
         # IDAS's own messages on calls the driver retries would only alarm (failures it cannot
@@ -71,6 +78,8 @@ class ContactStepper:
         # passed unnoticed), and the retry, shorter and after a jump check, beats waiting.
         self.opts["max_num_steps"] = min(int(opts.get("max_num_steps", MAX_CALL_STEPS)), MAX_CALL_STEPS)
         self.set_dae(dae_fn)
+        self.refused: dict[str, tuple[float, float]] = {}  # contact -> (wheel parameter, until t)
+        self._jumped_from = None  # (t, x, z, [(contact, new wheel parameter)]) of the last jump
         self.checks = check_contacts(form, x, z)
         self.span = min(min(c.span_s() for c in self.checks), self.switching.span_s(0.0, z, self.checks))
 
@@ -80,45 +89,70 @@ class ContactStepper:
         self._integrators = {}
 
     def call(self, x, z, t_a: float, h: float):
-        """State at ``t_a + h`` (one IDAS call; ``RuntimeError`` on failure)."""
-        key = float(f"{h:.12e}")  # output intervals differ in the last bits
-        integ = self._integrators.get(key)
-        if integ is None:
-            integ = self._integrators[key] = ca.integrator("idas", "idas", self.dae_fn, 0.0, [h], self.opts)
+        """State at ``t_a + h`` (one IDAS call; ``RuntimeError`` on failure). Each start needs a
+        consistent ``x_dot``: the DAE's own (exact, ``z`` being consistent) where integrators
+        are cheap to build (a compiled model DAE: 10 ms), else IDACalcIC's in an integrator
+        cached per call length (50 ms to build over the graph); see :meth:`_attempts`."""
         p = np.r_[t_a, self.switching.open]
-        try:
-            out = integ(x0=x, z0=z, p=p)
-        except RuntimeError as exc:
-            integ, out = self._fallback(x, z, p, h, exc)
-        st = integ.stats()
-        for k in self.stat_keys:
-            self.stats[k] += int(st.get(k, 0))
-        return np.asarray(out["xf"])[:, -1], np.asarray(out["zf"])[:, -1]
-
-    def _fallback(self, x, z, p, h, exc):
-        """The call once more, from the DAE's own ``x_dot`` instead of IDACalcIC (with GGL's
-        position rows, which hold no algebraic unknown, its Newton matrix is singular and may
-        fail on a state consistent to the tolerance), then with the LU solver (IDAS's first
-        steps of a microsecond call have ``cj = 1/h`` near 1e7, where the QR solver of the GGL
-        form has failed on consistent states). Uncached integrators: this is rare."""
-        x_dot = np.asarray(self.dae_fn(0.0, x, z, p, ca.DM(0, 1))[0]).ravel()
-        solvers = [self.opts.get("linear_solver")] if "IDACalcIC" in str(exc) else []
-        solvers += [s for s in ("csparse",) if s not in solvers]
-        for solver in solvers:
-            self.stats["contact_fallbacks"] += 1
-            opts = {**self.opts, "calc_ic": False, "init_xdot": x_dot.tolist(), "linear_solver": solver}
-            integ = ca.integrator("idas", "idas", self.dae_fn, 0.0, [h], opts)
+        x_dot = None
+        exc = None
+        for n, (solver, own) in enumerate(self._attempts()):
+            if n:
+                self.stats["contact_fallbacks"] += 1
+            if own:
+                if x_dot is None:
+                    x_dot = np.asarray(self.dae_fn(0.0, x, z, p, ca.DM(0, 1))[0]).ravel()
+                opts = {**self.opts, "calc_ic": False, "init_xdot": x_dot.tolist(), "linear_solver": solver}
+                integ = ca.integrator("idas", "idas", self.dae_fn, 0.0, [h], opts)
+            else:
+                key = float(f"{h:.12e}")  # output intervals differ in the last bits
+                integ = self._integrators.get(key)
+                if integ is None:
+                    integ = self._integrators[key] = ca.integrator("idas", "idas", self.dae_fn, 0.0, [h], self.opts)
             try:
-                return integ, integ(x0=x, z0=z, p=p)
+                out = integ(x0=x, z0=z, p=p)
             except RuntimeError as err:
                 exc = err
+                continue
+            st = integ.stats()
+            for k in self.stat_keys:
+                self.stats[k] += int(st.get(k, 0))
+            return np.asarray(out["xf"])[:, -1], np.asarray(out["zf"])[:, -1]
         raise exc
+
+    def _attempts(self):
+        """``(linear solver, own x_dot)`` to try in turn. IDACalcIC's Newton matrix is singular
+        with GGL's position rows (they hold no algebraic unknown) and may fail on a state
+        consistent to the tolerance; IDAS's first steps of a microsecond call have
+        ``cj = 1/h`` near 1e7, where the QR solver of the GGL form has failed on consistent
+        states that LU integrates."""
+        solver = self.opts.get("linear_solver")
+        if self.dae_fn.class_name() == "External":
+            return [(solver, True), ("csparse", True), (solver, False)]
+        return [(solver, False), (solver, True), ("csparse", True)]
+
+    def _stall_reason(self, exc) -> str:
+        flat = min(self.checks, key=lambda c: c.curvature_per_m)
+        last = str(exc).strip().splitlines()[-1] if str(exc).strip() else repr(exc)
+        return (f"{STALL_FAILURES} integrator calls failed within {STALL_SPAN_S:g} s of simulated time "
+                f"(last: {last.strip('. ')}); the flattest contact is {flat.name}, relative curvature "
+                f"{flat.curvature_per_m:.3g} 1/m with {len(flat.rivals)} other minima of the gap: nearly "
+                "conformal wheel and rail, where one constraint point per wheel is ill-conditioned (another "
+                "n_out or rtol moves the call boundaries; profiles with more curvature difference avoid it)")
 
     def _after(self, x, z, t, relaxed=False):
         checks = check_contacts(self.form, x, z)
-        x, z, jumped = jump_contacts(self.form, x, z, t, checks, relaxed, open_rows=self.switching.open_rows())
+        refused = {name: s1 for name, (s1, until) in self.refused.items() if t < until}
+        x_from, z_from = x, z
+        x, z, jumped = jump_contacts(self.form, x, z, t, checks, relaxed, open_rows=self.switching.open_rows(),
+                                     refused=refused)
+        self._jumped_from = None
         if jumped:
             self.stats["contact_jumps"] += len(jumped)
+            if not relaxed:
+                s = split_state(self.form, x, z)["s"]
+                index = {e.joint.name: e.s_index for e in self.form.model.wheelrail}
+                self._jumped_from = (t, x_from, z_from, [(n, float(s[index[n]])) for n in jumped])
             checks = check_contacts(self.form, x, z)
         x, z, switched = self.switching.update(x, z, t, checks)
         if switched:
@@ -133,7 +167,10 @@ class ContactStepper:
         """State at ``t1`` from ``(x, z)`` at ``t0``, with the contacts checked after every call.
         A failed call is retried from its start after a relaxed jump check (a point about as low;
         at most :data:`RELAXED_JUMPS` times in a row, lest two vanishing points alternate), else
-        four times shorter.
+        four times shorter. A call that fails right after a jump is retried from the point before
+        it, and the jump target is refused for :data:`REFUSAL_HOLD_S` (two points nanometres
+        apart in depth, IDAS failing from one: jumping back and forth would advance by
+        microseconds per cycle).
 
         Raises
         ------
@@ -148,6 +185,7 @@ class ContactStepper:
         # The position in units of dt / 2^k_max and the length in levels k (dt / 2^k).
         pos, end = 0, 2**k_max
         failures = 0
+        stall_t, stalled = t0, 0
         while pos < end:
             k = min(k_max, max(0, math.ceil(math.log2(dt / self.span)))) if self.span < dt else 0
             while pos % 2 ** (k_max - k):
@@ -159,6 +197,18 @@ class ContactStepper:
             except RuntimeError as exc:
                 self.stats["contact_retries"] += 1
                 failures += 1
+                if t - stall_t > STALL_SPAN_S:
+                    stall_t, stalled = t, 0
+                stalled += 1
+                if stalled > STALL_FAILURES:
+                    raise CallFailed(t, x, z, RuntimeError(self._stall_reason(exc))) from None
+                if self._jumped_from is not None and self._jumped_from[0] == t:
+                    _, x, z, targets = self._jumped_from
+                    for name, s1 in targets:
+                        self.refused[name] = (s1, t + REFUSAL_HOLD_S)
+                    self.stats["contact_refusals"] += 1
+                    x, z, _ = self._after(x, z, t)
+                    continue
                 x, z, jumped = self._after(x, z, t, relaxed=failures <= RELAXED_JUMPS)
                 if jumped:
                     continue

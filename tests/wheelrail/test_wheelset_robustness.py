@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from symcat.assembly.wheelrail import polach_forces_casadi, smooth_positive
-from symcat.integrate.contact_jumps import (FOLD_CURVATURE_PER_M, JUMP_TOLERANCE_M, ContactCheck, Rival,
-                                            relative_curvature)
+from symcat.integrate.contact_jumps import (FOLD_CURVATURE_PER_M, JUMP_TOLERANCE_M, REFUSED_RADIUS_M, ContactCheck,
+                                            Rival, relative_curvature)
 from symcat.model import run_model
 from symcat.wheelrail import profile_pair, wheelset_on_track
 from symcat.wheelrail.constraint_contact import WheelRailContact
@@ -191,6 +191,22 @@ def test_jump_targets_need_a_formed_rival_below_the_tolerance():
     # The call length: the rival closing in at 1 um/s from 1 nm above.
     closing = ContactCheck("w", 0.0, 1e-6, 1.0, math.inf, np.zeros(4), [Rival(Point(1e-9), formed, 0.0)])
     assert closing.span_s() == pytest.approx((1e-9 + 2 * JUMP_TOLERANCE_M) / 1e-6)
+
+
+def test_a_refused_jump_target_is_skipped_unless_relaxed():
+    class Point:
+        def __init__(self, gap, s1w):
+            self.gap_m, self.s = gap, np.array([s1w, 0.0, 0.0, 0.0])
+
+    formed = 10 * FOLD_CURVATURE_PER_M
+    two = ContactCheck("w", 0.0, 0.0, 1.0, math.inf, np.zeros(4),
+                       [Rival(Point(-1e-8, 0.010), formed, 0.0), Rival(Point(-5e-9, 0.030), formed, 0.0)])
+    assert two.target().point.s[0] == 0.010
+    assert two.target(refused=0.010 + 0.5 * REFUSED_RADIUS_M).point.s[0] == 0.030  # the next lowest
+    one = ContactCheck("w", 0.0, 0.0, 1.0, math.inf, np.zeros(4), [Rival(Point(-1e-8, 0.010), formed, 0.0)])
+    assert one.target(refused=0.010) is None
+    assert one.target(refused=0.010 + 2 * REFUSED_RADIUS_M) is not None          # another point
+    assert one.target(relaxed=True, refused=0.010) is not None                   # IDAS failed here too
 
 
 def _euler(rotation):
