@@ -59,6 +59,8 @@ TRAVEL_M = 5e-4
 #: A refused jump target (see :class:`.contact_stepping.ContactStepper`) covers the rivals this
 #: close to it along the wheel profile (m): it travels less in a refusal's hold.
 REFUSED_RADIUS_M = 1e-4
+#: Gap (m) of a jump target above which a GGL state is projected onto the position constraints.
+GGL_PROJECT_GAP_M = 1e-8
 #: Shortest integrator call (s): the floor of the predicted spans and of retries after a failure.
 MIN_SPAN_S = 1e-6
 
@@ -295,10 +297,12 @@ def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False, open
     parts = split_state(form, x, z)
     s = parts["s"].copy()
     jumped = []
+    deepest = 0.0
     for e, c in zip(model.wheelrail, checks):
         rival = c.target(relaxed, refused.get(e.joint.name))
         if rival is None:
             continue
+        deepest = max(deepest, abs(rival.point.gap_m))
         i = e.s_index
         new = rival.point.s.copy()
         # Keep the wheel angle continuous (it counts revolutions).
@@ -312,5 +316,9 @@ def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False, open
     # gap differs from the old one's by the margin only (both carry the same constraint drift,
     # which the Baumgarte terms remove). Projecting them onto C = 0 would shift and roll the
     # wheelset by that drift (micrometres at speed), enough to reorder minima nanometres apart.
-    x_new, z_new = consistent_state(form, t, start=start, positions=False, open_rows=open_rows)
+    # GGL has no Baumgarte terms: IDAS's first Newton iteration must close the gap within a
+    # step of a microsecond, and fails on a micrometre (a rival that deepened fast, e.g. a
+    # loaded wheelset sliding to the centre of S1002): such a state is projected.
+    project = form.index == "ggl" and deepest > GGL_PROJECT_GAP_M
+    x_new, z_new = consistent_state(form, t, start=start, positions=project, open_rows=open_rows)
     return x_new, z_new, jumped

@@ -112,7 +112,7 @@ class ContactStepper:
             try:
                 out = integ(x0=x, z0=z, p=p)
             except RuntimeError as err:
-                exc = err
+                exc = exc or err  # the first attempt's reason: the fallbacks' are consequences
                 continue
             st = integ.stats()
             for k in self.stat_keys:

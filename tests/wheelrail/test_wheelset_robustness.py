@@ -213,3 +213,44 @@ def _euler(rotation):
     from symcat.scene.rigid import euler_parameters
 
     return euler_parameters(rotation)
+
+
+@pytest.mark.parametrize("index", ["ggl", "1"])
+def test_a_jump_to_a_deeper_point_closes_the_gap_in_ggl(index):
+    """A rival micrometres below the followed point (a fast lateral motion outran the checks):
+    GGL, without Baumgarte terms, needs the state projected onto the constraints after the
+    jump; index 1 keeps the positions (its stabilization closes the gap)."""
+    from symcat.assembly.multibody import MultibodyModel
+    from symcat.dae.formulation import Formulation
+    from symcat.dae.initial import consistent_state
+    from symcat.integrate.contact_jumps import check_contacts, jump_contacts
+    from symcat.integrate.failure import restart_point, split_state
+    from symcat.scene import RigidBody, Scene, WheelRailJoint
+
+    pair = profile_pair("s1002_uic60")
+    placed = wheelset_on_track(pair.wheel, pair.rail, 0.0003)  # two minima on the left wheel
+    scene = Scene(gravity=(0.0, 0.0, -G))
+    scene.add(RigidBody("ws", 1813.0, (1120.0, 112.0, 1120.0), position=placed.position_m,
+                        rotation=placed.rotation))
+    for side in ("left", "right"):
+        scene.add(WheelRailJoint(f"wr_{side}", "ws", side, pair.wheel, pair.rail))
+    form = Formulation(MultibodyModel(scene), "augmented", index, 10.0, False)
+    x, z = consistent_state(form, 0.0)
+    # Follow the higher minimum of the left wheel: the lowest is then a rival below it.
+    parts = split_state(form, x, z)
+    contact = form.model.wheelrail[0].contact
+    minima = contact.local_minima(np.r_[placed.position_m, _euler(placed.rotation)], band_m=5e-4)
+    assert len(minima) >= 2
+    s = parts["s"].copy()
+    s[:4] = minima[1].s  # the placement follows the lowest
+    x, z = consistent_state(form, 0.0, start=restart_point(form, parts, s))
+    check = check_contacts(form, x, z)[0]
+    depth = check.gap_m - check.rivals[0].point.gap_m
+    assert depth > 1e-7 and check.target() is check.rivals[0]
+    x, z, jumped = jump_contacts(form, x, z, 0.0)
+    assert jumped[0] == "wr_left"
+    gap = check_contacts(form, x, z)[0].gap_m
+    if index == "ggl":
+        assert abs(gap) < 1e-10
+    else:
+        assert gap == pytest.approx(-depth, rel=1e-3)
