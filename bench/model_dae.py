@@ -45,13 +45,7 @@ def evaluation_times():
     model = _vehicle()
     form = Formulation(model, "augmented", "ggl", 10.0, False)
     x, z = consistent_state(form, 0.0)
-
-    def build():
-        d = form.dae()
-        return ca.Function("dae", [d["t"], d["x"], d["z"], d["p"], ca.MX.sym("u", 0)],
-                           [d["ode"], d["alg"], ca.MX(0, 1), ca.MX(0, 1)], ca.dyn_in(), ca.dyn_out())
-
-    graph, compiled = build(), compiled_dae(build)
+    graph, compiled = form.dae_function(), compiled_dae(form.dae_function)
     p = np.zeros(graph.size1_in(3))
     args = [0.0, x, z, p, ca.DM(0, 1)]
     rows = []

@@ -240,6 +240,14 @@ class Formulation:
         z += [("sc", self.n_sc)] if self.n_sc else []
         return _layout(x), _layout(z)
 
+    def dae_function(self) -> ca.Function:
+        """:meth:`dae` as the function IDAS takes: ``(t, x, z, p, u) -> (ode, alg, quad, zero)``
+        with an empty control and no quadratures or zero crossings. One per window: integrators
+        built from it share its cached Jacobian."""
+        d = self.dae()
+        return ca.Function("dae", [d["t"], d["x"], d["z"], d["p"], ca.MX.sym("u", 0)],
+                           [d["ode"], d["alg"], ca.MX(0, 1), ca.MX(0, 1)], ca.dyn_in(), ca.dyn_out())
+
     def dae(self) -> dict:
         """CasADi DAE dict ``{x, z, p, t, ode, alg}``; ``p`` is the time offset of the chunk and
         the open flags of the wheel/rail contacts (see the module's notes)."""

@@ -125,19 +125,13 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             stats[k] += int(st.get(k, 0))
         return np.asarray(out["xf"]), np.asarray(out["zf"])
 
-    def graph_dae():
-        d = form.dae()
-        # One Function per window: integrators built from it share its cached Jacobian.
-        return ca.Function("dae", [d["t"], d["x"], d["z"], d["p"], ca.MX.sym("u", 0)],
-                           [d["ode"], d["alg"], ca.MX(0, 1), ca.MX(0, 1)], ca.dyn_in(), ca.dyn_out())
-
     def dae_function():
         if compiled:
             try:
-                return compiled_dae(graph_dae)
+                return compiled_dae(form.dae_function)
             except RuntimeError as exc:  # a kernel outside the SX build: keep the graph
                 log.warning("the model's DAE could not be compiled (%s); evaluating its graph", exc)
-        return graph_dae()
+        return form.dae_function()
 
     try:
         if model.wheelrail:

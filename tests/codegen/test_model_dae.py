@@ -31,21 +31,13 @@ def _wheelset(profile="s1002_uic60", creep="polach"):
     return MultibodyModel(scene)
 
 
-def _graph(form):
-    def build():
-        d = form.dae()
-        return ca.Function("dae", [d["t"], d["x"], d["z"], d["p"], ca.MX.sym("u", 0)],
-                           [d["ode"], d["alg"], ca.MX(0, 1), ca.MX(0, 1)], ca.dyn_in(), ca.dyn_out())
-    return build
-
-
 @pytest.mark.parametrize("formulation,index", [("augmented", "ggl"), ("augmented", "1")])
 def test_compiled_residual_and_jacobian_equal_the_graph(formulation, index, rng):
     model = _wheelset()
     form = Formulation(model, formulation, index, 10.0, False)
     x, z = consistent_state(form, 0.0)
-    graph = _graph(form)()
-    compiled = compiled_dae(_graph(form))
+    graph = form.dae_function()
+    compiled = compiled_dae(form.dae_function)
     assert compiled.class_name() == "External"
     n_p = graph.size1_in(3)
     for k in range(4):
