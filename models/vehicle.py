@@ -82,6 +82,8 @@ PARAMETERS = [
     Parameter("index", "ggl", "", "constraint stabilization: GGL (positions held) or index 1 with Baumgarte",
               choices=("ggl", "1")),
     Parameter("rtol", 1e-7, "-", "IDAS relative tolerance", minimum=0.0, maximum=0.1, exclusive_minimum=True),
+    Parameter("atol", 0.0, "m", "IDAS absolute tolerance of positions (m, rad) and velocities (m/s, rad/s); 0: rtol/10",
+              minimum=0.0, maximum=0.1),
     Parameter("n_out", 100, "-", "output intervals", minimum=10, maximum=100000),
 ]
 
@@ -151,8 +153,8 @@ def summarize(res, layout) -> dict:
 def run(p: dict) -> ModelOutput:
     _, layout, model = build(p)
     try:
-        res = simulate(model, p["t_end"], index=p["index"], rtol=p["rtol"], n_out=int(p["n_out"]),
-                       progress=p.get("progress", True))
+        res = simulate(model, p["t_end"], index=p["index"], rtol=p["rtol"], atol=p.get("atol") or 0.1 * p["rtol"],
+                       n_out=int(p["n_out"]), progress=p.get("progress", True))
     except SolverError as err:
         hint = "; in a canted curve index=1 (the cant ramps' ends are impacts)" if p.get("cant_m", 0.0) > 0 else ""
         raise SolverError(f"{err} (vehicle model: try index=ggl or a tighter rtol{hint}; a flange contact or a contact "

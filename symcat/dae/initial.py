@@ -181,20 +181,52 @@ def kkt_solve_closed(m, f, cq, cs, qd, closed, n_c: int):
     """:func:`kkt_solve` with only the ``closed`` constraint rows (``cq``, ``cs``, ``qd`` are
     theirs); the multipliers come back for all ``n_c`` rows, zero on the open ones (lifted-off
     wheel/rail contacts carry no force)."""
-    a, s_dd, lam_closed = kkt_solve(m, f, cq, cs, qd)
-    lam = np.zeros(n_c)
-    lam[closed] = lam_closed
-    return a, s_dd, lam
+    return kkt_solver_closed(m, cq, cs, closed, n_c)(f, qd)
+
+
+def kkt_solver_closed(m, cq, cs, closed, n_c: int):
+    """``solve(f, qd)`` of :func:`kkt_solve_closed`, the matrix factorized once (the creep
+    passes of :class:`CreepCoupling` change the forces only)."""
+    solve = kkt_solver(m, cq, cs)
+
+    def solve_closed(f, qd):
+        a, s_dd, lam_closed = solve(f, qd)
+        lam = np.zeros(n_c)
+        lam[closed] = lam_closed
+        return a, s_dd, lam
+
+    return solve_closed
 
 
 def kkt_solve(m, f, cq, cs, qd):
     """Accelerations, arc-length accelerations and multipliers of the augmented form (eq. 25)
     for a consistent state: ``[[M, 0, C_q^T], [0, 0, C_s^T], [C_q, C_s, 0]]``."""
+    return kkt_solver(m, cq, cs)(f, qd)
+
+
+def kkt_solver(m, cq, cs):
+    """``solve(f, qd) -> (a, s_dd, lam)`` of :func:`kkt_solve`, with one LU factorization."""
     n_f, n_s = m.shape[0], cs.shape[1]
     kkt = sps.bmat([[m, None, cq.T], [None, sps.csc_matrix((n_s, n_s)), sps.csc_matrix(cs.T)],
                     [cq, sps.csc_matrix(cs), None]], format="csc")
-    sol = _solve(kkt, np.r_[f, np.zeros(n_s), -qd])
-    return sol[:n_f], sol[n_f : n_f + n_s], sol[n_f + n_s :]
+    try:
+        lu = spla.splu(kkt) if kkt.shape[0] else None
+    except RuntimeError:  # exactly singular: _solve's message
+        lu = None
+
+    def solve(f, qd):
+        b = np.r_[f, np.zeros(n_s), -qd]
+        if lu is None:
+            sol = _solve(kkt, b)
+        else:
+            with np.errstate(all="ignore"):
+                sol = np.atleast_1d(lu.solve(b))
+            if not np.all(np.isfinite(sol)):
+                raise SolverError("singular system while making the initial conditions consistent (redundant "
+                                  "constraints?)")
+        return sol[:n_f], sol[n_f : n_f + n_s], sol[n_f + n_s :]
+
+    return solve
 
 
 def _solve(a: sps.spmatrix, b: np.ndarray) -> np.ndarray:

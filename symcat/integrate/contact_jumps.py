@@ -156,13 +156,14 @@ class ContactCheck:
         return max(min(spans), MIN_SPAN_S)
 
 
-def relative_curvature(contact, q, s) -> float:
+def relative_curvature(contact, q, s, kernels=None) -> float:
     """Relative curvature (1/m) of wheel and rail across the profile at surface parameters ``s``:
     the derivative of the wheel-profile tangency row ``t1w . n^r`` along the wheel profile's arc
     length with the other three conditions held (a Schur complement of ``C_s``). Equal to
     ``-(k_wheel + k_rail)`` of the profiles' curvatures (:meth:`Profile.curvature`) on tangent
-    track; positive at a minimum of the gap, zero where the point meets a maximum and vanishes."""
-    k = contact.evaluate(q, s, clip=True)
+    track; positive at a minimum of the gap, zero where the point meets a maximum and vanishes.
+    ``kernels``: :meth:`evaluate`'s at ``(q, s)``, if at hand."""
+    k = contact.evaluate(q, s, clip=True) if kernels is None else kernels
     t = k.C_s
     rows, cols = [0, 1, 4], [1, 2, 3]
     reduced = t[3, 0] - t[3, cols] @ np.linalg.solve(t[np.ix_(rows, cols)], t[rows, 0])
@@ -202,29 +203,32 @@ def check_contacts(form, x, z) -> list[ContactCheck]:
         k = e.contact.evaluate(q, s, clip=True)
         tr = list(TANGENCY_ROWS)
         s_rate = -np.linalg.solve(k.C_s[tr], k.C_q[tr] @ q_dot)
-        gap = e.contact.gap(q, s)
-        kappa = relative_curvature(e.contact, q, s)
+        gap = e.contact.gap(q, s, kernels=k)
+        kappa = relative_curvature(e.contact, q, s, k)
         check = ContactCheck(e.joint.name, gap, float(k.C_q[GAP_ROW] @ q_dot + k.C_s[GAP_ROW] @ s_rate), kappa,
                              halving_time(e.contact, s, s_rate, kappa), s_rate)
         own = _own_point(e.contact, q, s, k)
-        for p in _minima(e.contact, q, s, gap * k.C_q[GAP_ROW, :3]):
+        for p in _minima(e.contact, q, s, gap * k.C_q[GAP_ROW, :3], own):
             if own is None or abs(p.s[0] - own) > SAME_POINT_M:
-                rate = float(e.contact.evaluate(q, p.s).C_q[GAP_ROW] @ q_dot)
-                check.rivals.append(Rival(p, relative_curvature(e.contact, q, p.s), rate))
+                k_p = e.contact.evaluate(q, p.s, clip=True)
+                check.rivals.append(Rival(p, relative_curvature(e.contact, q, p.s, k_p),
+                                          float(k_p.C_q[GAP_ROW] @ q_dot)))
         out.append(check)
     return out
 
 
-def _minima(contact, q, s, offset) -> list:
+def _minima(contact, q, s, offset, own=None) -> list:
     """Local minima of the gap at ``q`` (lowest first), searched for with the wheelset moved by
     ``-offset`` (the followed point's gap along the rail normal) onto the rail: the vertical
     clearances of the search differ from normal gaps by ``gap * tan(angle) * d(angle)``, which
     with micrometres of constraint drift shifts or erases the minima of a flat valley (tenths of
-    a millimetre apart, nanometres deep). Each is then refined at ``q`` itself."""
+    a millimetre apart, nanometres deep). Each is then refined at ``q`` itself. ``own``: the
+    followed point's own wheel parameter (:func:`_own_point`), already solved for: the search's
+    minimum at it is neither refined nor returned."""
     q_touch = np.array(q, float)
     q_touch[:3] -= offset
     try:
-        found = contact.local_minima(q_touch, near=s[0])
+        found = contact.local_minima(q_touch, near=s[0], known=own)
     except SolverError:
         return []
     out = []

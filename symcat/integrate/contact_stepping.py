@@ -25,6 +25,9 @@ from .failure import split_state
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
+#: A jump target this deep at a call's end (m) means the jump came late: the call is redone
+#: shorter (:meth:`ContactStepper._late_jump`).
+LATE_JUMP_GAP_M = 1e-8
 #: Relaxed jumps tried after consecutive failed calls from one state.
 RELAXED_JUMPS = 3
 #: How long (s) a jump target stays refused after IDAS failed from it (see ``advance``).
@@ -57,7 +60,9 @@ class ContactStepper:
     stats : dict
         Summed IDAS statistics (``stat_keys``) and the counts ``contact_jumps``,
         ``contact_calls``, ``contact_retries``, ``contact_fallbacks``, ``contact_refusals``,
-        ``lift_offs`` and ``touchdowns``.
+        ``lift_offs``, ``touchdowns``, ``switch_redos`` and ``jump_redos`` (calls redone up to
+        a switch or a contact jump they passed unpredicted,
+        :meth:`.contact_switching.Switching.overshoot`, :meth:`_late_jump`).
     open_flags : ndarray, optional
         Contacts open at the start (:func:`.contact_switching.initial_open`); default none.
     """
@@ -67,7 +72,7 @@ class ContactStepper:
         self.stats = stats
         self.stat_keys = stat_keys
         for key in ("contact_jumps", "contact_calls", "contact_retries", "contact_fallbacks", "contact_refusals",
-                    "lift_offs", "touchdowns"):
+                    "lift_offs", "touchdowns", "switch_redos", "jump_redos"):
             stats.setdefault(key, 0)
         self.switching = Switching(form, np.zeros(len(form.model.wheelrail)) if open_flags is None else open_flags)
         # IDAS's own messages on calls the driver retries would only alarm (failures it cannot
@@ -88,12 +93,16 @@ class ContactStepper:
         self.dae_fn = dae_fn
         self._integrators = {}
 
-    def call(self, x, z, t_a: float, h: float):
-        """State at ``t_a + h`` (one IDAS call; ``RuntimeError`` on failure). Each start needs a
-        consistent ``x_dot``: the DAE's own (exact, ``z`` being consistent) where integrators
-        are cheap to build (a compiled model DAE: 10 ms), else IDACalcIC's in an integrator
-        cached per call length (50 ms to build over the graph); see :meth:`_attempts`."""
+    def call(self, x, z, t_a: float, h: float, inner=()):
+        """States at ``t_a + inner`` and at ``t_a + h``: ``(x, z)``, one column per time (one
+        IDAS call; ``RuntimeError`` on failure). ``inner``: offsets (s) in ``(0, h)`` of output
+        times inside the call (IDAS interpolates them: they do not limit its steps). Each start
+        needs a consistent ``x_dot``: the DAE's own (exact, ``z`` being consistent) where
+        integrators are cheap to build (a compiled model DAE: 10 ms), else IDACalcIC's in an
+        integrator cached per call length and grid (50 ms to build over the graph); see
+        :meth:`_attempts`."""
         p = np.r_[t_a, self.switching.open]
+        grid = [float(v) for v in inner] + [h]
         x_dot = None
         exc = None
         for n, (solver, own) in enumerate(self._attempts()):
@@ -103,12 +112,12 @@ class ContactStepper:
                 if x_dot is None:
                     x_dot = np.asarray(self.dae_fn(0.0, x, z, p, ca.DM(0, 1))[0]).ravel()
                 opts = {**self.opts, "calc_ic": False, "init_xdot": x_dot.tolist(), "linear_solver": solver}
-                integ = ca.integrator("idas", "idas", self.dae_fn, 0.0, [h], opts)
+                integ = ca.integrator("idas", "idas", self.dae_fn, 0.0, grid, opts)
             else:
-                key = float(f"{h:.12e}")  # output intervals differ in the last bits
+                key = tuple(float(f"{v:.12e}") for v in grid)  # output intervals differ in the last bits
                 integ = self._integrators.get(key)
                 if integ is None:
-                    integ = self._integrators[key] = ca.integrator("idas", "idas", self.dae_fn, 0.0, [h], self.opts)
+                    integ = self._integrators[key] = ca.integrator("idas", "idas", self.dae_fn, 0.0, grid, self.opts)
             try:
                 out = integ(x0=x, z0=z, p=p)
             except RuntimeError as err:
@@ -117,7 +126,7 @@ class ContactStepper:
             st = integ.stats()
             for k in self.stat_keys:
                 self.stats[k] += int(st.get(k, 0))
-            return np.asarray(out["xf"])[:, -1], np.asarray(out["zf"])[:, -1]
+            return np.asarray(out["xf"]), np.asarray(out["zf"])
         raise exc
 
     def _attempts(self):
@@ -140,8 +149,28 @@ class ContactStepper:
                 "conformal wheel and rail, where one constraint point per wheel is ill-conditioned (another "
                 "n_out or rtol moves the call boundaries; profiles with more curvature difference avoid it)")
 
-    def _after(self, x, z, t, relaxed=False):
-        checks = check_contacts(self.form, x, z)
+    def _late_jump(self, checks_end, h: float, t: float) -> float | None:
+        """Time (s after the call's start) at which a rival sank below the followed point, if at
+        the call's end one lies deeper than :data:`LATE_JUMP_GAP_M` (linear interpolation of
+        its margin from the call's start; half the call if it was not there yet): the jump is
+        then redone at about that time. The rates' linear prediction (:meth:`ContactCheck.span_s`)
+        misses a rival that speeds up; a late jump lifts the wheelset (GGL projects onto the
+        deeper point: energy gained) or leaves it penetrating (index 1)."""
+        refused = {name: s1 for name, (s1, until) in self.refused.items() if t + h < until}
+        first = None
+        for start, end in zip(self.checks, checks_end):
+            rival = end.target(False, refused.get(end.name))
+            if rival is None or rival.point.gap_m >= -LATE_JUMP_GAP_M:
+                continue
+            m1 = end.margin_m(rival)
+            formed = [start.margin_m(r) for r in start.rivals if r.formed]
+            m0 = min(formed) if formed else None
+            f = m0 / (m0 - m1) if m0 is not None and m0 > 0 > m1 else 0.5
+            first = f * h if first is None else min(first, f * h)
+        return first
+
+    def _after(self, x, z, t, relaxed=False, checks=None):
+        checks = check_contacts(self.form, x, z) if checks is None else checks
         refused = {name: s1 for name, (s1, until) in self.refused.items() if t < until}
         x_from, z_from = x, z
         x, z, jumped = jump_contacts(self.form, x, z, t, checks, relaxed, open_rows=self.switching.open_rows(),
@@ -163,8 +192,13 @@ class ContactStepper:
         self.checks = checks
         return x, z, jumped + [s.name for s in switched]
 
-    def advance(self, x, z, t0: float, t1: float):
-        """State at ``t1`` from ``(x, z)`` at ``t0``, with the contacts checked after every call.
+    def advance(self, x, z, t0: float, times, emit=None):
+        """State at ``times[-1]`` from ``(x, z)`` at ``t0``, with the contacts checked after
+        every call; ``emit(j, x, z)`` receives the state at each of the increasing output
+        ``times`` (> ``t0``) as soon as it is known. The output times do not end calls: a call
+        spans as many of them as the contacts allow (:meth:`call`), so that dense output costs
+        no contact checks and no IDAS restarts.
+
         A failed call is retried from its start after a relaxed jump check (a point about as low;
         at most :data:`RELAXED_JUMPS` times in a row, lest two vanishing points alternate), else
         four times shorter. A call that fails right after a jump is retried from the point before
@@ -180,20 +214,26 @@ class ContactStepper:
         SolverError
             If a wheel runs off its rail or lifts off (:func:`lost_contact`).
         """
+        times = np.atleast_1d(np.asarray(times, float))
+        t1 = float(times[-1])
         dt = t1 - t0
         k_max = max(0, math.ceil(math.log2(dt / MIN_SPAN_S)))
         # The position in units of dt / 2^k_max and the length in levels k (dt / 2^k).
         pos, end = 0, 2**k_max
         failures = 0
         stall_t, stalled = t0, 0
+        emitted = 0
         while pos < end:
             k = min(k_max, max(0, math.ceil(math.log2(dt / self.span)))) if self.span < dt else 0
             while pos % 2 ** (k_max - k):
                 k += 1  # aligned, so that the calls end exactly on t1
             t = t0 + dt * pos / end
             h = dt / 2**k
+            t_b = t0 + dt * (pos + 2 ** (k_max - k)) / end
+            # Output times strictly inside the call (those within rounding of its end are its end).
+            inside = [j for j in range(emitted, len(times) - 1) if times[j] < t_b - 1e-12 * max(1.0, abs(t_b))]
             try:
-                x_new, z_new = self.call(x, z, t, h)
+                xs_new, zs_new = self.call(x, z, t, h, [times[j] - t for j in inside])
             except RuntimeError as exc:
                 self.stats["contact_retries"] += 1
                 failures += 1
@@ -220,9 +260,34 @@ class ContactStepper:
                 raise CallFailed(t, x, z, exc) from None
             self.stats["contact_calls"] += 1
             failures = 0
+            if k < k_max:
+                offsets = [times[j] - t for j in inside] + [h]
+                t_switch = self.switching.overshoot(z, self.checks, offsets, xs_new, zs_new)
+                if t_switch is not None:
+                    # A switch passed unpredicted: redo the call up to just before it.
+                    self.stats["switch_redos"] += 1
+                    self.span = max(0.9 * t_switch, MIN_SPAN_S)
+                    continue
+            checks_end = check_contacts(self.form, xs_new[:, -1], zs_new[:, -1])
+            if k < k_max:
+                t_late = self._late_jump(checks_end, h, t)
+                if t_late is not None:
+                    # A rival sank below the followed point unpredicted: redo up to before it.
+                    self.stats["jump_redos"] += 1
+                    self.span = max(0.9 * t_late, MIN_SPAN_S)
+                    continue
             pos += 2 ** (k_max - k)
-            x, z, _ = self._after(x_new, z_new, t0 + dt * pos / end)
+            for col, j in enumerate(inside):
+                if emit is not None:
+                    emit(j, xs_new[:, col], zs_new[:, col])
+            emitted += len(inside)
+            x, z, _ = self._after(xs_new[:, -1], zs_new[:, -1], t_b, checks=checks_end)
+            # A call ending on an output time emits the state after the contact check (jumps).
+            while emitted < len(times) and abs(times[emitted] - t_b) <= 1e-12 * max(1.0, abs(t_b)):
+                if emit is not None:
+                    emit(emitted, x, z)
+                emitted += 1
             reason = lost_contact(self.form, x, z, self.checks)
             if reason is not None:
-                raise SolverError(f"at t = {t0 + dt * pos / end:.6g} s {reason}; the results so far are in .partial")
+                raise SolverError(f"at t = {t_b:.6g} s {reason}; the results so far are in .partial")
         return x, z

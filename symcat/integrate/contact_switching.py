@@ -14,7 +14,9 @@ DAE parameter, next to the time offset.
 The switches are located between the driver's short calls (:mod:`.contact_stepping`): a call
 lasts at most half the time the normal force of a closed contact is predicted to take to reach
 zero (linearly from its last two values), or the gap of an open one (from its rate), so the
-calls shorten geometrically toward a switch.
+calls shorten geometrically toward a switch. A call that passed a switch unpredicted (no rate
+known yet, or one that turned around inside the call) is redone up to the interpolated switch
+(:meth:`Switching.overshoot`).
 
 Only the rail-frame form (eq. 22) has a gap row to release; a global-form (eq. 21) contact whose
 normal force turns negative still ends the run (:func:`.contact_jumps.lost_contact`).
@@ -51,6 +53,16 @@ def normal_forces(form, z) -> np.ndarray:
     """Normal force (N) of every wheel/rail contact at the algebraic state ``z``."""
     lam = np.asarray(z)[form.blocks()[1]["lambda"].slice]
     return -lam[form.normal_force_index()]
+
+
+def contact_gaps(form, x, z) -> np.ndarray:
+    """Gap (m) of every wheel/rail contact at the state ``(x, z)``, its surface parameters as
+    they are."""
+    model = form.model
+    parts = split_state(form, x, z)
+    q = model.q0.copy()
+    q[model.free] = form.to_physical(parts["q"])
+    return np.array([e.contact.gap(q[e.rows], parts["s"][e.s_index : e.s_index + 4]) for e in model.wheelrail])
 
 
 def initial_open(form) -> np.ndarray:
@@ -103,6 +115,39 @@ class Switching:
                 if rate < 0 and normal[k] > 0:
                     span = min(span, 0.5 * normal[k] / -rate)
         return max(span, MIN_SPAN_S)
+
+    def overshoot(self, z0, checks0, offsets, xs, zs) -> float | None:
+        """Time (s after the call's start) at which a call, from the checked state ``(z0,
+        checks0)`` through the states ``xs, zs`` (columns) at ``offsets``, made its first
+        switch (linear interpolation of the normal force or the gap between the states around
+        it), or ``None``: a call longer than the predictions (the first after a start or a
+        switch, with no rate known yet; a force that turned around inside it) is redone up to
+        there, so that a switch is located as closely as a predicted one. The states inside the
+        call are its output times: a switch between two of them that undoes itself is not
+        seen."""
+        rows = [k for k in self.releasable]
+        if not rows:
+            return None
+        n_prev = normal_forces(self.form, z0)
+        g_prev = np.array([c.gap_m for c in checks0])
+        t_prev = 0.0
+        for col, t_col in enumerate(offsets):
+            n_col = normal_forces(self.form, zs[:, col])
+            g_col = contact_gaps(self.form, xs[:, col], zs[:, col]) if self.open[rows].any() else g_prev
+            first = None
+            for k in rows:
+                f = None
+                if self.open[k]:
+                    if g_prev[k] > 0 > g_col[k]:
+                        f = g_prev[k] / (g_prev[k] - g_col[k])
+                elif n_prev[k] > 0 > n_col[k] and checks0[k].curvature_per_m >= FOLD_CURVATURE_PER_M:
+                    f = n_prev[k] / (n_prev[k] - n_col[k])
+                if f is not None:
+                    first = f if first is None else min(first, f)
+            if first is not None:
+                return t_prev + first * (t_col - t_prev)
+            n_prev, g_prev, t_prev = n_col, g_col, t_col
+        return None
 
     def update(self, x, z, t: float, checks):
         """Open the closed contacts whose normal force is negative (not at a fold, where the

@@ -14,7 +14,7 @@ import scipy.sparse.linalg as spla
 from ..assembly.sparse import to_scipy
 from ..assembly.wheelrail import GAP_ROW
 from ..dae.formulation import Formulation
-from ..dae.initial import CreepCoupling, kkt_solve_closed
+from ..dae.initial import CreepCoupling, kkt_solver_closed
 from .failure import split_state
 
 @dataclass
@@ -158,8 +158,8 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events) -> Simul
             creep = CreepCoupling(form, p["q"], p["v"], p["s"], s_dot[i], normal_rows)
             mass_i, cq_i = to_scipy(mass), to_scipy(cq).tocsr()[closed].tocsc()
             cs_i, qd_i = np.asarray(ca.densify(cs))[closed], np.asarray(qd).ravel()[closed]
-            a_i, _, lam[i] = creep.solve(lambda f: kkt_solve_closed(mass_i, f, cq_i, cs_i, qd_i, closed, model.n_c),
-                                         np.asarray(force).ravel())
+            solve = kkt_solver_closed(mass_i, cq_i, cs_i, closed, model.n_c)
+            a_i, _, lam[i] = creep.solve(lambda f: solve(f, qd_i), np.asarray(force).ravel())
             if creep.active:
                 creep_record[i] = np.asarray(creep_fn(p["q"], p["v"], p["s"], s_dot[i], -lam[i][normal_rows])[1]).ravel()
         else:

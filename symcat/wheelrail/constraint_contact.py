@@ -227,10 +227,11 @@ class WheelRailContact:
         y = np.r_[np.asarray(q, float), np.asarray(s, float)]
         return _np(self.kernels[f"{self.library}_c"](y, t, self.parameters(s, **kw))).ravel()
 
-    def gap(self, q, s) -> float:
+    def gap(self, q, s, kernels=None) -> float:
         """Normal gap (m) at surface parameters ``s`` as they are (no solve): the gap row of
-        eq. 22, or the rail-normal component of eq. 21's distance rows."""
-        k = self.evaluate(q, s, clip=True)
+        eq. 22, or the rail-normal component of eq. 21's distance rows. ``kernels``:
+        :meth:`evaluate`'s at ``(q, s)`` (with ``clip``), if at hand."""
+        k = self.evaluate(q, s, clip=True) if kernels is None else kernels
         if self.form == "railframe":
             return float(k.c[2])
         return float(self._normal_from_jacobian(k.C_s) @ k.c[:3])
@@ -290,13 +291,13 @@ class WheelRailContact:
             grid = np.linspace(max(grid[j] - h, lo), min(grid[j] + h, hi), 9)
         return np.array([best[0], s2w, best[2], best[1]])
 
-    def local_minima(self, q, band_m: float = 2e-6, grid_m: float = 2.5e-4, near: float | None = None
-                     ) -> list[ContactPoint]:
+    def local_minima(self, q, band_m: float = 2e-6, grid_m: float = 2.5e-4, near: float | None = None,
+                     known: float | None = None) -> list[ContactPoint]:
         """Every local minimum of the gap along the wheel profile, lowest first
         (:func:`.gap_minima.gap_minima`)."""
         from .gap_minima import gap_minima
 
-        return gap_minima(self, q, band_m, grid_m, near)
+        return gap_minima(self, q, band_m, grid_m, near, known)
 
     def _vertical_gap(self, q, a, s2w, s1w, s_guess):
         """Gap along the rail profile's ``z`` of the wheel points ``(s1w, s2w)``, the rail

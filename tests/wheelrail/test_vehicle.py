@@ -35,7 +35,10 @@ def test_static_wheel_loads_sum_to_the_weight_and_follow_the_load_path():
     # Frictionless contacts on a 1:20 tread: the normal force is Q / cos(contact angle).
     angle = layout.placements["b1_ws1"].contacts["left"].contact_angle_rad
     np.testing.assert_allclose(forces["b1_ws1_left"]["normal_N"], q[0] / np.cos(angle), rtol=1e-6)
-    assert res.position_drift.max() < 1e-9
+    # GGL holds the positions where IDAS stops (the run's end: 1e-15 measured); the outputs
+    # inside a call are IDAS's interpolation, within its tolerance (2.2e-8 m measured).
+    assert res.position_drift[-1] < 1e-9
+    assert res.position_drift.max() < 1e-7
 
 
 def test_centred_vehicle_stays_symmetric_at_speed_on_s1002():
