@@ -255,3 +255,42 @@ def test_a_jump_to_a_deeper_point_closes_the_gap_in_ggl(index):
         assert abs(gap) < 1e-10
     else:
         assert gap == pytest.approx(-depth, rel=1e-3)
+
+
+@pytest.mark.parametrize("profile, shift_m", [("s1002_uic60", 0.0003), ("s1002_uic60", 0.0075),
+                                              ("en15302_a", 0.004), ("conical", 0.002)])
+@pytest.mark.parametrize("yaw_rad", [0.0, 0.004, -0.02])
+def test_screened_gap_minima_equal_the_full_three_angle_search(profile, shift_m, yaw_rad, monkeypatch):
+    """gap_minima evaluates the three angles of a circle only where yaw can lower it into the
+    band (``R (h' sin psi)^2 / 2``): the same minima as evaluating them everywhere, on the
+    flange (7.5 mm) and the conformal centre of S1002, yawed up to 20 mrad."""
+    from symcat.scene.rigid import euler_parameters
+    from symcat.wheelrail import gap_minima as module
+
+    pair = profile_pair(profile, 0.05)
+    placed = wheelset_on_track(pair.wheel, pair.rail, shift_m)
+    c, s_ = math.cos(yaw_rad), math.sin(yaw_rad)
+    rotation = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]]) @ placed.rotation
+    q = np.r_[placed.position_m, euler_parameters(rotation)]
+    for side in ("left", "right"):
+        contact = WheelRailContact(pair.wheel, pair.rail, side)
+        screened = contact.local_minima(q, band_m=5e-4)
+        monkeypatch.setattr(module, "OFF_BOTTOM_SAFETY", math.inf)
+        full = contact.local_minima(q, band_m=5e-4)
+        monkeypatch.undo()
+        assert len(screened) == len(full) >= 1
+        for a, b in zip(screened, full):
+            np.testing.assert_allclose(a.s[[0, 2, 3]], b.s[[0, 2, 3]], atol=1e-9)
+            assert a.gap_m == pytest.approx(b.gap_m, abs=1e-12)
+
+
+def test_dense_output_costs_no_contact_calls():
+    """The stepper's calls cross output times (IDAS interpolates them): 15 or 300 outputs (the same
+    0.1 s spans of the driver) give
+    the same calls, and the states at the common times agree to the tolerance."""
+    sparse = _run(profile="s1002_uic60", creep="none", t_end=0.3, n_out=15, rtol=1e-8)
+    dense = _run(profile="s1002_uic60", creep="none", t_end=0.3, n_out=300, rtol=1e-8)
+    assert dense.stats["contact_calls"] == sparse.stats["contact_calls"]
+    assert dense.stats["contact_jumps"] == sparse.stats["contact_jumps"] >= 1
+    y_sparse, y_dense = sparse.coordinate("wheelset.y"), dense.coordinate("wheelset.y")[::20]
+    np.testing.assert_allclose(y_dense, y_sparse, rtol=0, atol=1e-9)
