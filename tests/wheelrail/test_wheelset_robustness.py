@@ -285,9 +285,9 @@ def test_screened_gap_minima_equal_the_full_three_angle_search(profile, shift_m,
 
 
 def test_dense_output_costs_no_contact_calls():
-    """The stepper's calls cross output times (IDAS interpolates them): 15 or 300 outputs (the same
-    0.1 s spans of the driver) give
-    the same calls, and the states at the common times agree to the tolerance."""
+    """The stepper's calls cross output times (IDAS interpolates them): 15 or 300 outputs (the
+    same 0.1 s spans of the driver) give the same calls, and the states at the common times
+    agree to the tolerance."""
     sparse = _run(profile="s1002_uic60", creep="none", t_end=0.3, n_out=15, rtol=1e-8)
     dense = _run(profile="s1002_uic60", creep="none", t_end=0.3, n_out=300, rtol=1e-8)
     assert dense.stats["contact_calls"] == sparse.stats["contact_calls"]
