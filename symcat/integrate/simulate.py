@@ -164,7 +164,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
                 try:
                     x, z = stepper.advance(x, z, t_grid[a], t_grid[a + 1 : b + 1], emit)
                 except CallFailed as exc:
-                    raise failure(form, exc.error, exc.t, exc.x, exc.z, stepper.dae_fn, t_grid[a + 1] - exc.t,
+                    raise failure(form, exc.error, exc.t, exc.x, exc.z, stepper.dae_fn, t_grid[1] - t_grid[0],
                                   stepper.switching.open) from None
                 a = b
         a, limit = (n_out if model.wheelrail else 0), None
