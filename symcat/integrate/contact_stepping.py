@@ -3,8 +3,9 @@
 
 The calls are many (hundreds per simulated second while a contact point crosses a nearly
 conformal region) and building an integrator costs about as much as a short call, so the call
-lengths are binary fractions ``dt / 2^k`` of the output interval, aligned so that they add up
-to it exactly, and (over CasADi's graph) one integrator per ``k`` serves all calls of that
+lengths are binary fractions ``dt / 2^k`` of the driver's span (output intervals grouped to
+about 0.1 s; the output times inside a call are interpolated by IDAS), aligned so that they add
+up to it exactly, and (over CasADi's graph) one integrator per ``k`` serves all calls of that
 length, IDAS finding the consistent ``x_dot`` at each start (``calc_ic``). A compiled model DAE
 builds an integrator in 10 ms: each call then starts from the DAE's own ``x_dot``, which spares
 IDACalcIC (30 % of the wall time of an S1002 vehicle; see :meth:`ContactStepper.call`).

@@ -125,7 +125,7 @@ class Switching:
         there, so that a switch is located as closely as a predicted one. The states inside the
         call are its output times: a switch between two of them that undoes itself is not
         seen."""
-        rows = [k for k in self.releasable]
+        rows = sorted(self.releasable)
         if not rows:
             return None
         n_prev = normal_forces(self.form, z0)
