@@ -11,7 +11,10 @@ import numpy as np
 from symcat.errors import SolverError
 from symcat.model import load_model
 
-T_END = 1.0
+T_END = 0.4
+#: The reference run: rtol 1e-8 fails with IDA_CONV_FAIL (0.85 s conical, 0.425 s S1002 at
+#: 1 s), the Newton iteration not converging to that tolerance; atol 100x below the rows'.
+REFERENCE = {"rtol": 1e-7, "atol": 1e-9}
 REPEATS = 3
 
 
@@ -28,13 +31,13 @@ def _lateral(out):
 
 
 def work_precision(profile="conical"):
-    """Largest wheelset lateral-displacement error against rtol 1e-8, GGL stabilization (atol
-    the model's default, rtol / 10)."""
+    """Largest wheelset lateral-displacement error against :data:`REFERENCE`, GGL stabilization
+    (atol the model's default, rtol / 10)."""
     base = {"profile": profile, "t_end": T_END, "n_out": 50, "lateral_offset_m": 0.002}
     try:
-        ref = _lateral(_run("vehicle", {**base, "rtol": 1e-8}))
+        ref = _lateral(_run("vehicle", {**base, **REFERENCE}))
     except SolverError as err:
-        return [(profile, 1e-8, float("nan"), float("nan"), 0, "reference: " + str(err).split(":")[0])]
+        return [(profile, REFERENCE["rtol"], float("nan"), float("nan"), 0, "reference: " + str(err).split(":")[0])]
     rows = []
     for rtol in (1e-4, 1e-5, 1e-6, 1e-7):
         walls, out, failed = [], None, ""
@@ -71,7 +74,7 @@ def section(report_dir=None) -> list[str]:
         "## Seed vehicle (`vehicle`) and complete scene (`seo2005`)",
         "",
         f"17 m/s, linear creep, 2 mm initial offset, {T_END:g} s, GGL stabilization, atol = rtol / 10. Error: largest "
-        "difference of the four wheelsets' lateral displacement from the same model at rtol 1e-8. Wall time "
+        "difference of the four wheelsets' lateral displacement from the same model at rtol 1e-7, atol 1e-9. Wall time "
         f"per simulated second: median of {REPEATS} runs (including post-processing of 50 outputs).",
         "",
         "| profiles | rtol | error [m] | wall per simulated s | steps | failure |",
