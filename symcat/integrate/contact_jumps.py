@@ -43,7 +43,7 @@ import numpy as np
 from ..assembly.wheelrail import GAP_ROW, TANGENCY_ROWS
 from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
-from .failure import restart_point, split_state
+from .failure import physical_coordinates, restart_point, split_state
 
 #: A minimum this much below the followed point (m) triggers a jump.
 JUMP_TOLERANCE_M = 1e-9
@@ -193,9 +193,7 @@ def check_contacts(form, x, z) -> list[ContactCheck]:
     """:class:`ContactCheck` of every wheel/rail contact at the state ``(x, z)``."""
     model = form.model
     parts = split_state(form, x, z)
-    q_full, v_full = model.q0.copy(), np.zeros(model.n_q)
-    q_full[model.free] = form.to_physical(parts["q"])
-    v_full[model.free] = form.to_physical(parts["v"])
+    q_full, v_full = physical_coordinates(form, parts)
     out = []
     for e in model.wheelrail:
         q, q_dot = q_full[e.rows], v_full[e.rows]

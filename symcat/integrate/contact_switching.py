@@ -30,7 +30,7 @@ import numpy as np
 
 from ..dae.initial import consistent_state
 from .contact_jumps import FOLD_CURVATURE_PER_M, MIN_SPAN_S
-from .failure import restart_point, split_state
+from .failure import physical_coordinates, restart_point, split_state
 
 #: A contact whose gap exceeds this at the start (m) starts open (a wheelset dropped on its rails).
 INITIAL_OPEN_GAP_M = 1e-5
@@ -58,11 +58,9 @@ def normal_forces(form, z) -> np.ndarray:
 def contact_gaps(form, x, z) -> np.ndarray:
     """Gap (m) of every wheel/rail contact at the state ``(x, z)``, its surface parameters as
     they are."""
-    model = form.model
     parts = split_state(form, x, z)
-    q = model.q0.copy()
-    q[model.free] = form.to_physical(parts["q"])
-    return np.array([e.contact.gap(q[e.rows], parts["s"][e.s_index : e.s_index + 4]) for e in model.wheelrail])
+    q, _ = physical_coordinates(form, parts)
+    return np.array([e.contact.gap(q[e.rows], parts["s"][e.s_index : e.s_index + 4]) for e in form.model.wheelrail])
 
 
 def initial_open(form) -> np.ndarray:

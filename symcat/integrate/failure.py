@@ -15,6 +15,16 @@ def split_state(form, x, z) -> dict:
     return out
 
 
+def physical_coordinates(form, parts) -> tuple[np.ndarray, np.ndarray]:
+    """All generalized coordinates and velocities of the model (fixed ones at their initial
+    values) from :func:`split_state`'s ``parts``."""
+    model = form.model
+    q, v = model.q0.copy(), np.zeros(model.n_q)
+    q[model.free] = form.to_physical(parts["q"])
+    v[model.free] = form.to_physical(parts["v"])
+    return q, v
+
+
 def restart_point(form, parts: dict, s=None) -> dict:
     """``start`` for :func:`symcat.dae.initial.consistent_state` from a split state (``s``
     replaces the surface parameters, e.g. after a contact jump)."""

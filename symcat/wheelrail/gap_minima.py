@@ -72,14 +72,14 @@ def gap_minima(contact, q, band_m: float = 2e-6, grid_m: float = 2.5e-4, near: f
     with np.errstate(invalid="ignore"):  # inf - inf off the rail: not a candidate
         candidate = gap - OFF_BOTTOM_SAFETY * lowering <= gap.min() + band_m
     candidate &= np.isfinite(gap)
+    s2w = np.full(len(grid), bottom)
     if sin_yaw != 0.0 and candidate.any():
         step = 0.05  # rad
         sub = grid[candidate]
         g = [np.nan_to_num(contact._vertical_gap(q, a, bottom + k * step, sub, s_axle)[0], nan=np.inf)
              for k in (-1, 1)]
-        g1 = gap[candidate]
         with np.errstate(invalid="ignore", divide="ignore"):  # inf off the rail
-            curv = g[0] + g[1] - 2 * g1
+            curv = g[0] + g[1] - 2 * gap[candidate]
             shift = np.where(curv > 0, 0.5 * step * (g[0] - g[1]) / curv, 0.0)
         s2w_sub = bottom + np.clip(np.nan_to_num(shift), -3 * step, 3 * step)
         moved = s2w_sub != bottom
@@ -87,13 +87,8 @@ def gap_minima(contact, q, band_m: float = 2e-6, grid_m: float = 2.5e-4, near: f
             gm, r2m, r1m = contact._vertical_gap(q, a, s2w_sub[moved], sub[moved], s_axle)
             idx = np.flatnonzero(candidate)[moved]
             better = np.isfinite(gm) & (gm < gap[idx])
-            gap[idx[better]], s2r[idx[better]], s1r[idx[better]] = gm[better], r2m[better], r1m[better]
-            s2w = np.full(len(grid), bottom)
-            s2w[idx[better]] = s2w_sub[moved][better]
-        else:
-            s2w = np.full(len(grid), bottom)
-    else:
-        s2w = np.full(len(grid), bottom)
+            i = idx[better]
+            gap[i], s2r[i], s1r[i], s2w[i] = gm[better], r2m[better], r1m[better], s2w_sub[moved][better]
     lower = (gap <= np.r_[np.inf, gap[:-1]]) & (gap <= np.r_[gap[1:], np.inf])
     points: list[ContactPoint] = []
     for j in np.flatnonzero(lower & (gap <= gap.min() + band_m)):
