@@ -22,8 +22,9 @@ change: a plastic impact at the new point) before IDAS restarts; the positions s
 
 A call lasts at most until (a) the followed point has travelled :data:`TRAVEL_M` along the wheel
 profile, (b) about half the time until its relative curvature has halved (predicted from the
-profiles' curvatures along its path, so that the calls shorten geometrically toward a fold), or
-(c) the lowest formed rival is predicted :data:`JUMP_TOLERANCE_M` below it. The rates are exact:
+profiles' curvatures along its path, so that the calls shorten geometrically toward a fold),
+or (c) the lowest formed rival is predicted :data:`JUMP_TOLERANCE_M` below it. On rails with
+kinks (cant ramps) the travel is shorter (:func:`travel_limit`). The rates are exact:
 ``s_dot = -C_Ts^-1 C_Tq q_dot``, and the gap of a stationary point changes at
 ``C_q[gap] q_dot`` (its derivative in ``s`` vanishes there).
 
@@ -55,10 +56,15 @@ OWN_RADIUS_M = 1e-5
 #: (a relative radius above 20 m: a Hertz ellipse as wide as the rail head).
 FOLD_CURVATURE_PER_M = 0.05
 #: Largest travel of a followed contact point along the wheel profile between two checks (m).
-TRAVEL_M = 5e-4
+TRAVEL_M = 2e-3
 #: A refused jump target (see :class:`.contact_stepping.ContactStepper`) covers the rivals this
 #: close to it along the wheel profile (m): it travels less in a refusal's hold.
 REFUSED_RADIUS_M = 1e-4
+#: Largest travel (m) on rails with kinks (cant ramps' ends, crossed as impacts: the tangency
+#: conditions step with the rail's slope, and the contact point reaches the stationary point
+#: past the crease by jumps, :func:`jump_contacts`, which longer calls find too late: with
+#: :data:`TRAVEL_M`, the index-1 wheelset of the cant-ramp test drifts 4 mm off its rails).
+KINK_TRAVEL_M = 5e-4
 #: Gap (m) of a jump target above which a GGL state is projected onto the position constraints.
 GGL_PROJECT_GAP_M = 1e-8
 #: Shortest integrator call (s): the floor of the predicted spans and of retries after a failure.
@@ -102,6 +108,9 @@ class ContactCheck:
         The other local minima of the gap, lowest first: all but the followed point's own (see
         :func:`_own_point`). In a flat valley of nearly conformal profiles they may be tens of
         micrometres away.
+    travel_m : float
+        Largest travel (m) along the wheel profile in the next call: :data:`TRAVEL_M`, or
+        :data:`KINK_TRAVEL_M` on rails with kinks (:func:`travel_limit`).
     """
 
     name: str
@@ -111,6 +120,7 @@ class ContactCheck:
     fold_in_s: float
     s_rate: np.ndarray
     rivals: list = field(default_factory=list)
+    travel_m: float = TRAVEL_M
 
     def margin_m(self, rival: Rival) -> float:
         """Rival's gap minus the followed point's (m)."""
@@ -141,14 +151,14 @@ class ContactCheck:
 
     def span_s(self) -> float:
         """Longest next integrator call (s) for this contact: until the followed point has
-        travelled :data:`TRAVEL_M` along the wheel; half the predicted time until its relative
+        travelled :attr:`travel_m` along the wheel; half the predicted time until its relative
         curvature has halved (the contact point speeds up toward a fold, where ``kappa`` goes as
         ``sqrt(t_fold - t)``: the linear prediction would reach the fold itself); until the
         lowest formed rival is predicted :data:`JUMP_TOLERANCE_M` below it (linearly, from the
         rates). At least :data:`MIN_SPAN_S`."""
         spans = [math.inf, 0.5 * self.fold_in_s]
         if abs(self.s_rate[0]) > 0:
-            spans.append(TRAVEL_M / abs(self.s_rate[0]))
+            spans.append(self.travel_m / abs(self.s_rate[0]))
         formed = [r for r in self.rivals if r.formed]
         if formed and formed[0].gap_rate_m_s < self.gap_rate_m_s:
             closing = self.gap_rate_m_s - formed[0].gap_rate_m_s
@@ -189,6 +199,12 @@ def halving_time(contact, s, s_rate, kappa: float, samples: int = 64) -> float:
     return float(tau[low[0]]) if low.size else math.inf
 
 
+def travel_limit(frames) -> float:
+    """Largest travel (m) of a contact point along the wheel profile in one call:
+    :data:`KINK_TRAVEL_M` if its rail has kinks (``frames.kinks_m``), else :data:`TRAVEL_M`."""
+    return KINK_TRAVEL_M if len(getattr(frames, "kinks_m", ())) else TRAVEL_M
+
+
 def check_contacts(form, x, z) -> list[ContactCheck]:
     """:class:`ContactCheck` of every wheel/rail contact at the state ``(x, z)``."""
     model = form.model
@@ -204,7 +220,8 @@ def check_contacts(form, x, z) -> list[ContactCheck]:
         gap = e.contact.gap(q, s, kernels=k)
         kappa = relative_curvature(e.contact, q, s, k)
         check = ContactCheck(e.joint.name, gap, float(k.C_q[GAP_ROW] @ q_dot + k.C_s[GAP_ROW] @ s_rate), kappa,
-                             halving_time(e.contact, s, s_rate, kappa), s_rate)
+                             halving_time(e.contact, s, s_rate, kappa), s_rate,
+                             travel_m=travel_limit(e.contact.frames))
         own = _own_point(e.contact, q, s, k)
         for p in _minima(e.contact, q, s, gap * k.C_q[GAP_ROW, :3], own):
             if own is None or abs(p.s[0] - own) > SAME_POINT_M:

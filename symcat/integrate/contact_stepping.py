@@ -1,14 +1,20 @@
 """The IDAS driver of wheel/rail models: short integrator calls with contact checks between them
 (see :mod:`.contact_jumps` for what is checked and how long a call may be).
 
-The calls are many (hundreds per simulated second while a contact point crosses a nearly
+The calls are many (tens to hundreds per simulated second while a contact point crosses a nearly
 conformal region) and building an integrator costs about as much as a short call, so the call
 lengths are binary fractions ``dt / 2^k`` of the driver's span (output intervals grouped to
 about 0.1 s; the output times inside a call are interpolated by IDAS), aligned so that they add
-up to it exactly, and (over CasADi's graph) one integrator per ``k`` serves all calls of that
-length, IDAS finding the consistent ``x_dot`` at each start (``calc_ic``). A compiled model DAE
-builds an integrator in 10 ms: each call then starts from the DAE's own ``x_dot``, which spares
-IDACalcIC (30 % of the wall time of an S1002 vehicle; see :meth:`ContactStepper.call`).
+up to it exactly, and one integrator per call grid serves all calls on that grid. IDAS needs a
+consistent ``x_dot`` at each start, which CasADi takes from a construction option: the
+integrator therefore solves for the state's departure from its linear extrapolation,
+``x = x_a + (t - t_a) x_dot_a + D xi`` (:func:`shifted_dae`), whose consistent start is
+``xi = 0``, ``xi_dot = 0`` for every call; ``x_a``, ``x_dot_a`` (the DAE's own, exact for a
+consistent ``z``) and ``D`` are parameters. The scaling ``D = 1 + rtol |x_a| / atol`` keeps
+IDAS's error weights those of ``x`` (its relative part measured on ``xi`` alone would tighten
+the test on large coordinates). This spares both a fresh integrator per call (10 ms for a
+compiled DAE, 50 ms over the graph) and IDACalcIC (30 % of the wall time of an S1002 vehicle),
+which remains the last resort (:meth:`ContactStepper._attempts`).
 (An integrator in normalized time ``tau = (t - t_a) / h`` would serve every length, but IDAS
 then takes a hundred times longer to give up at a fold.)
 """
@@ -26,6 +32,10 @@ from .failure import split_state
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
+#: IDAS's first step in a call, relative to the call's length.
+INITIAL_STEP = 1e-3
+#: Integrators kept (one per call grid and linear solver; a long run meets many grids).
+MAX_INTEGRATORS = 64
 #: A jump target this deep at a call's end (m) means the jump came late: the call is redone
 #: shorter (:meth:`ContactStepper._late_jump`).
 LATE_JUMP_GAP_M = 1e-8
@@ -80,6 +90,7 @@ class ContactStepper:
         # recover from are reported with the time and the worst residual).
         self.opts = {**{k: v for k, v in opts.items() if k != "init_xdot"}, "calc_ic": True,
                      "disable_internal_warnings": True}
+        self.opts.setdefault("reltol", 1e-6)
         # A call is at most one output interval: this many steps mean a singularity (a fold
         # passed unnoticed), and the retry, shorter and after a jump check, beats waiting.
         self.opts["max_num_steps"] = min(int(opts.get("max_num_steps", MAX_CALL_STEPS)), MAX_CALL_STEPS)
@@ -92,54 +103,79 @@ class ContactStepper:
     def set_dae(self, dae_fn) -> None:
         """Use ``dae_fn`` from now on (e.g. after a window moved)."""
         self.dae_fn = dae_fn
+        self._shifted = None
         self._integrators = {}
 
     def call(self, x, z, t_a: float, h: float, inner=()):
         """States at ``t_a + inner`` and at ``t_a + h``: ``(x, z)``, one column per time (one
         IDAS call; ``RuntimeError`` on failure). ``inner``: offsets (s) in ``(0, h)`` of output
-        times inside the call (IDAS interpolates them: they do not limit its steps). Each start
-        needs a consistent ``x_dot``: the DAE's own (exact, ``z`` being consistent) where
-        integrators are cheap to build (a compiled model DAE: 10 ms), else IDACalcIC's in an
-        integrator cached per call length and grid (50 ms to build over the graph); see
-        :meth:`_attempts`."""
+        times inside the call (IDAS interpolates them: they do not limit its steps). The
+        integrator, cached per grid, solves the shifted DAE (:func:`shifted_dae`) from the
+        DAE's own ``x_dot``; see :meth:`_attempts` for the fallbacks."""
         p = np.r_[t_a, self.switching.open]
         grid = [float(v) for v in inner] + [h]
+        x = np.asarray(x, float)
         x_dot = None
         exc = None
-        for n, (solver, own) in enumerate(self._attempts()):
+        for n, (solver, shifted) in enumerate(self._attempts()):
             if n:
                 self.stats["contact_fallbacks"] += 1
-            if own:
-                if x_dot is None:
-                    x_dot = np.asarray(self.dae_fn(0.0, x, z, p, ca.DM(0, 1))[0]).ravel()
-                opts = {**self.opts, "calc_ic": False, "init_xdot": x_dot.tolist(), "linear_solver": solver}
-                integ = ca.integrator("idas", "idas", self.dae_fn, 0.0, grid, opts)
-            else:
-                key = tuple(float(f"{v:.12e}") for v in grid)  # output intervals differ in the last bits
-                integ = self._integrators.get(key)
-                if integ is None:
-                    integ = self._integrators[key] = ca.integrator("idas", "idas", self.dae_fn, 0.0, grid, self.opts)
+            integ = self._integrator(grid, solver, shifted)
             try:
-                out = integ(x0=x, z0=z, p=p)
+                if shifted:
+                    if x_dot is None:
+                        x_dot = np.asarray(self.dae_fn(0.0, x, z, p, ca.DM(0, 1))[0]).ravel()
+                        scale = 1.0 + self.opts["reltol"] * np.abs(x) / self._atol(len(x))
+                    out = integ(x0=np.zeros(len(x)), z0=z, p=np.r_[p, x, x_dot, scale])
+                else:
+                    out = integ(x0=x, z0=z, p=p)
             except RuntimeError as err:
                 exc = exc or err  # the first attempt's reason: the fallbacks' are consequences
                 continue
             st = integ.stats()
             for k in self.stat_keys:
                 self.stats[k] += int(st.get(k, 0))
-            return np.asarray(out["xf"]), np.asarray(out["zf"])
+            xs = np.asarray(out["xf"])
+            if shifted:
+                xs = x[:, None] + np.outer(x_dot, grid) + scale[:, None] * xs
+            return xs, np.asarray(out["zf"])
         raise exc
 
+    def _integrator(self, grid, solver: str, shifted: bool):
+        """The integrator of the shifted DAE (or, not ``shifted``, of the DAE itself with
+        IDACalcIC) on ``grid`` with ``solver``, built on first use."""
+        key = (solver, shifted) + tuple(float(f"{v:.12e}") for v in grid)  # intervals differ in the last bits
+        integ = self._integrators.get(key)
+        if integ is None:
+            if shifted:
+                if self._shifted is None:
+                    self._shifted = shifted_dae(self.dae_fn)
+                # IDAS's first step would be a thousandth of the first output time (xi_dot = 0
+                # gives it no other scale): the call's length instead, so that the steps do not
+                # depend on the outputs inside the call.
+                dae, opts = self._shifted, {**self.opts, "calc_ic": False, "step0": INITIAL_STEP * grid[-1]}
+            else:
+                dae, opts = self.dae_fn, self.opts
+            if len(self._integrators) >= MAX_INTEGRATORS:
+                del self._integrators[next(iter(self._integrators))]  # the oldest
+            integ = self._integrators[key] = ca.integrator("idas", "idas", dae, 0.0, grid,
+                                                           {**opts, "linear_solver": solver})
+        return integ
+
+    def _atol(self, n_x: int) -> np.ndarray:
+        """Absolute tolerances of the differential states."""
+        if "abstolv" in self.opts:
+            return np.asarray(self.opts["abstolv"][:n_x], float)
+        return np.full(n_x, float(self.opts.get("abstol", 1e-8)))
+
     def _attempts(self):
-        """``(linear solver, own x_dot)`` to try in turn. IDACalcIC's Newton matrix is singular
-        with GGL's position rows (they hold no algebraic unknown) and may fail on a state
-        consistent to the tolerance; IDAS's first steps of a microsecond call have
-        ``cj = 1/h`` near 1e7, where the QR solver of the GGL form has failed on consistent
-        states that LU integrates."""
+        """``(linear solver, shifted)`` to try in turn. IDAS's first steps of a microsecond call
+        have ``cj = 1/h`` near 1e7, where the QR solver of the GGL form has failed on consistent
+        states that LU integrates; IDACalcIC (not shifted) last: its Newton matrix is singular
+        with GGL's position rows (they hold no algebraic unknown) and it may fail on a state
+        consistent to the tolerance."""
         solver = self.opts.get("linear_solver")
-        if self.dae_fn.class_name() == "External":
-            return [(solver, True), ("csparse", True), (solver, False)]
-        return [(solver, False), (solver, True), ("csparse", True)]
+        return [(solver, True), ("csparse", True), (solver, False)]
 
     def _stall_reason(self, exc) -> str:
         flat = min(self.checks, key=lambda c: c.curvature_per_m)
@@ -292,3 +328,18 @@ class ContactStepper:
             if reason is not None:
                 raise SolverError(f"at t = {t_b:.6g} s {reason}; the results so far are in .partial")
         return x, z
+
+
+def shifted_dae(dae_fn: ca.Function) -> ca.Function:
+    """The DAE ``(t, x, z, p, u) -> (ode, alg, quad, zero)`` in the state's scaled departure from
+    its linear extrapolation: ``x = x_a + t x_dot_a + D xi``, ``xi_dot = (ode - x_dot_a) / D``,
+    with ``p`` extended by ``x_a``, ``x_dot_a`` and ``D``. ``xi = 0`` with ``xi_dot = 0`` is a
+    consistent start when ``x_dot_a`` is the DAE's own ``ode`` there (see the module docstring)."""
+    n_x, n_z, n_p = dae_fn.size1_in(1), dae_fn.size1_in(2), dae_fn.size1_in(3)
+    t, xi, z = ca.MX.sym("t"), ca.MX.sym("xi", n_x), ca.MX.sym("z", n_z)
+    p_ext, u = ca.MX.sym("p", n_p + 3 * n_x), ca.MX.sym("u", dae_fn.size1_in(4))
+    p, x_a = p_ext[:n_p], p_ext[n_p : n_p + n_x]
+    x_dot_a, scale = p_ext[n_p + n_x : n_p + 2 * n_x], p_ext[n_p + 2 * n_x :]
+    ode, alg, quad, zero = dae_fn(t, x_a + t * x_dot_a + scale * xi, z, p, u)
+    return ca.Function(f"{dae_fn.name()}_shifted", [t, xi, z, p_ext, u], [(ode - x_dot_a) / scale, alg, quad, zero],
+                       dae_fn.name_in(), dae_fn.name_out())

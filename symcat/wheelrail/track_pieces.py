@@ -44,6 +44,16 @@ SIDES = {"left": 1.0, "right": -1.0}
 N_PIECE = 22
 
 
+def _cant_rate_steps(layout: TrackLayout, eps_m: float = 1e-4) -> np.ndarray:
+    """Interior segment joins [m] of ``layout`` where the superelevation's slope changes."""
+    joins = layout.joins_m[1:-1]
+    if joins.size == 0:
+        return np.zeros(0)
+    h = [layout.superelevation(joins + d) for d in (-eps_m, 0.0, eps_m)]
+    step = np.abs((h[2] - h[1]) - (h[1] - h[0])) / eps_m
+    return joins[step > 1e-9]
+
+
 def rot_x(a: float) -> np.ndarray:
     c, s = math.cos(a), math.sin(a)
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
@@ -77,6 +87,8 @@ class TangentRailFrames:
         self.origin_m = rot_x(self.cant_rad) @ np.array([0.0, self.sign * offset, 0.0])
         self.roll_rad = self.cant_rad + self.sign * extra
         self.head = np.array([self.origin_m[1], self.origin_m[2], self.roll_rad])
+        #: Chainages of the rails' kinks [m]: none on tangent track.
+        self.kinks_m = np.zeros(0)
 
     def params(self, s1r: float, clip: bool = False) -> np.ndarray:
         """Track parameters of the kernel beyond the head (none on tangent track)."""
@@ -149,6 +161,9 @@ class TrackRailFrames:
         self.table = np.column_stack([x[:-1], origin.reshape(len(h), 12), psi, phi, np.full(len(h), self.theta_rad)])
         self.head = np.array([0.0, 0.0, self.sign * layout.inclination_rad])
         self.roll_rad = float(self.head[2])
+        #: Chainages of the rails' kinks [m]: the segment joins where the cant rate steps (the
+        #: ends of linear cant ramps), crossed as impacts.
+        self.kinks_m = _cant_rate_steps(layout)
 
     # ------------------------------------------------------------------ pieces
     def index(self, s1r, clip: bool = False) -> np.ndarray:
