@@ -37,7 +37,7 @@ from ..assembly.multibody import MultibodyModel
 from ..assembly.sparse import to_scipy
 from ..dae.formulation import Formulation
 from ..errors import SolverError
-from ..integrate.results import _reactions
+from ..integrate.results import joint_reactions
 
 
 @dataclass
@@ -200,14 +200,12 @@ def _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, h0, t0):
     q[model.free] = form.to_physical(u[:n_f])
     lam = u[n_f + n_s + n_sc :].copy()
     cq, gap, fc = (np.asarray(ca.densify(x)) for x in kkt.extras(u))
-    reactions = {name.split("[")[0]: np.zeros((1, 3)) for name in model.row_names}
-    _reactions(model, form, cq, lam, reactions, 0)
     names = [ct.joint.name for ct in model.contacts]
     return EquilibriumResult(
         q=q, s_m=u[n_f : n_f + n_s].copy(), sc_m=u[n_f + n_s : n_f + n_s + n_sc].copy(),
         multipliers=lam, residual_N=float(f_norm),
         constraint_residual=float(np.abs(r[nf:]).max(initial=0.0)), iterations=len(history),
-        wall_s=time.perf_counter() - t0, history=history, reactions_N={k: v[0] for k, v in reactions.items()},
+        wall_s=time.perf_counter() - t0, history=history, reactions_N=joint_reactions(model, cq, lam),
         contact_gap_m=dict(zip(names, gap.ravel().tolist())), contact_force_N=dict(zip(names, fc.ravel().tolist())))
 
 

@@ -170,11 +170,69 @@ class CreepCoupling:
         for _ in range(max_iterations):
             out = solve(f + self.force(normal))
             new = -np.asarray(out[-1])[self.index]
-            if np.abs(new - normal).max(initial=0.0) <= tol * (1.0 + np.abs(new).max(initial=0.0)):
+            if _settled(new, normal, tol):
                 return out
             normal = new
-        raise SolverError(f"creep forces and normal forces did not settle in {max_iterations} passes "
-                          f"(normal forces {np.array2string(new, precision=4)} N)")
+        raise _unsettled(max_iterations, new)
+
+
+def settle_creep(solves, f, creep_force, index, tol: float = 1e-10, max_iterations: int = 50) -> list:
+    """:meth:`CreepCoupling.solve` for many states at once, the creep forces of all of them
+    evaluated in one call per pass; each state takes the passes it would take alone (the same
+    results).
+
+    Parameters
+    ----------
+    solves : list of callables
+        ``solves[i](force) -> (..., multipliers)``: the linear solve of state ``i``.
+    f : ndarray (n, n_f)
+        The forces without creep.
+    creep_force : callable
+        ``creep_force(normal) -> (n, n_f)``: the creep forces of every state for its normal
+        forces ``normal`` (n, n_w).
+    index : list of int
+        Where the normal forces sit in the multipliers (minus them).
+    tol, max_iterations
+        As for :meth:`CreepCoupling.solve`.
+
+    Returns
+    -------
+    list
+        The last ``solves[i]`` output of every state.
+
+    Raises
+    ------
+    SolverError
+        If a state's normal forces do not settle.
+    """
+    outs = [solve(fi) for solve, fi in zip(solves, f)]
+    normal = np.array([-np.asarray(out[-1])[index] for out in outs]).reshape(len(outs), len(index))
+    pending = list(range(len(outs)))
+    for _ in range(max_iterations):
+        if not pending:
+            break
+        force = creep_force(normal)  # every state in one call; the settled ones' are not used
+        still = []
+        for i in pending:
+            outs[i] = solves[i](f[i] + force[i])
+            new = -np.asarray(outs[i][-1])[index]
+            if not _settled(new, normal[i], tol):
+                still.append(i)
+            normal[i] = new
+        pending = still
+    if pending:
+        raise _unsettled(max_iterations, normal[pending[0]])
+    return outs
+
+
+def _settled(new, normal, tol) -> bool:
+    """Normal forces that a creep pass no longer changes (relative ``tol``)."""
+    return np.abs(new - normal).max(initial=0.0) <= tol * (1.0 + np.abs(new).max(initial=0.0))
+
+
+def _unsettled(max_iterations, normal) -> SolverError:
+    return SolverError(f"creep forces and normal forces did not settle in {max_iterations} passes "
+                       f"(normal forces {np.array2string(normal, precision=4)} N)")
 
 
 def kkt_solve_closed(m, f, cq, cs, qd, closed, n_c: int):
@@ -187,7 +245,12 @@ def kkt_solve_closed(m, f, cq, cs, qd, closed, n_c: int):
 def kkt_solver_closed(m, cq, cs, closed, n_c: int):
     """``solve(f, qd)`` of :func:`kkt_solve_closed`, the matrix factorized once (the creep
     passes of :class:`CreepCoupling` change the forces only)."""
-    solve = kkt_solver(m, cq, cs)
+    return _all_rows(kkt_solver(m, cq, cs), closed, n_c)
+
+
+def _all_rows(solve, closed, n_c: int):
+    """``solve`` with the multipliers of the ``closed`` rows spread over all ``n_c`` (zero on
+    the open ones)."""
 
     def solve_closed(f, qd):
         a, s_dd, lam_closed = solve(f, qd)
@@ -196,6 +259,62 @@ def kkt_solver_closed(m, cq, cs, closed, n_c: int):
         return a, s_dd, lam
 
     return solve_closed
+
+
+class KKTPattern:
+    """The matrix of :func:`kkt_solver_closed` assembled from nonzeros by fixed index maps: for
+    many states with the same sparsity patterns of ``M``, ``C_q``, ``C_s`` and the same closed
+    rows (``scipy.sparse.bmat`` per state costs ten times the factorization).
+
+    Parameters
+    ----------
+    m, cq, cs : casadi.Sparsity
+        Patterns of the mass matrix (n_f x n_f) and of ``C_q`` (n_c x n_f) and ``C_s``
+        (n_c x n_s) over all constraint rows.
+    closed : ndarray of int
+        The closed rows (:func:`kkt_solver_closed`).
+    """
+
+    def __init__(self, m: ca.Sparsity, cq: ca.Sparsity, cs: ca.Sparsity, closed):
+        self.n_f, self.n_s, self.n_c = m.size1(), cs.size2(), cq.size1()
+        self.closed = np.asarray(closed, int)
+        at = np.full(self.n_c, -1)
+        at[self.closed] = np.arange(self.closed.size)
+        off = self.n_f + self.n_s  # first constraint row of the KKT matrix
+        m_r, m_c = (np.asarray(x, int) for x in m.get_triplet())
+        cq_r, cq_c = (np.asarray(x, int) for x in cq.get_triplet())
+        cs_r, cs_c = (np.asarray(x, int) for x in cs.get_triplet())
+        cq_k, cs_k = np.flatnonzero(at[cq_r] >= 0), np.flatnonzero(at[cs_r] >= 0)
+        # Entries: M; C_q^T and C_q; C_s^T and C_s (closed rows), as positions in the stacked
+        # nonzeros [M, C_q, C_s].
+        rows = np.r_[m_r, cq_c[cq_k], off + at[cq_r[cq_k]], self.n_f + cs_c[cs_k], off + at[cs_r[cs_k]]]
+        cols = np.r_[m_c, off + at[cq_r[cq_k]], cq_c[cq_k], off + at[cs_r[cs_k]], self.n_f + cs_c[cs_k]]
+        n_m, n_cq = m.nnz(), cq.nnz()
+        source = np.r_[np.arange(n_m), n_m + cq_k, n_m + cq_k, n_m + n_cq + cs_k, n_m + n_cq + cs_k]
+        order = np.lexsort((rows, cols))  # CSC: by column, rows ascending
+        self.size = off + self.closed.size
+        self._source, self._rows, self._cols = source[order], rows[order].astype(np.int32), cols[order]
+        self._indptr = self._column_starts(self._cols)
+        # C_s enters as a dense block in kkt_solver: its exact zeros are no entries.
+        self._from_cs = np.flatnonzero(self._source >= n_m + n_cq)
+
+    def solver(self, m_nz, cq_nz, cs_nz):
+        """``solve(f, qd) -> (a, s_dd, lam)`` of :func:`kkt_solver_closed` (``qd`` of the closed
+        rows, ``lam`` over all rows) from the nonzeros of ``M``, ``C_q`` and ``C_s`` in their
+        patterns' order; the same matrix, hence the same factorization."""
+        data = np.concatenate((m_nz, cq_nz, cs_nz))[self._source]
+        rows, indptr = self._rows, self._indptr
+        zeros = self._from_cs[data[self._from_cs] == 0.0]
+        if zeros.size:
+            keep = np.ones(data.size, bool)
+            keep[zeros] = False
+            data, rows, indptr = data[keep], rows[keep], self._column_starts(self._cols[keep])
+        kkt = sps.csc_matrix((data, rows, indptr), shape=(self.size, self.size))
+        return _all_rows(_lu_solver(kkt, self.n_f, self.n_s), self.closed, self.n_c)
+
+    def _column_starts(self, cols: np.ndarray) -> np.ndarray:
+        """CSC ``indptr`` of entries in columns ``cols`` (sorted)."""
+        return np.concatenate(([0], np.cumsum(np.bincount(cols, minlength=self.size)))).astype(np.int32)
 
 
 def kkt_solve(m, f, cq, cs, qd):
@@ -209,13 +328,18 @@ def kkt_solver(m, cq, cs):
     n_f, n_s = m.shape[0], cs.shape[1]
     kkt = sps.bmat([[m, None, cq.T], [None, sps.csc_matrix((n_s, n_s)), sps.csc_matrix(cs.T)],
                     [cq, sps.csc_matrix(cs), None]], format="csc")
+    return _lu_solver(kkt, n_f, n_s)
+
+
+def _lu_solver(kkt: sps.csc_matrix, n_f: int, n_s: int):
+    """``solve(f, qd) -> (a, s_dd, lam)`` for the KKT matrix of :func:`kkt_solver`."""
     try:
         lu = spla.splu(kkt) if kkt.shape[0] else None
     except RuntimeError:  # exactly singular: _solve's message
         lu = None
 
     def solve(f, qd):
-        b = np.r_[f, np.zeros(n_s), -qd]
+        b = np.concatenate((f, np.zeros(n_s), -np.asarray(qd)))
         if lu is None:
             sol = _solve(kkt, b)
         else:

@@ -9,13 +9,12 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
+import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
-from ..assembly.sparse import to_scipy
 from ..assembly.wheelrail import GAP_ROW
 from ..dae.formulation import Formulation
-from ..dae.initial import CreepCoupling, kkt_solver_closed
-from .failure import split_state
+from ..dae.initial import KKTPattern, settle_creep
 
 @dataclass
 class SimulationResult:
@@ -104,72 +103,49 @@ def collect_result(form: Formulation, t, xs, zs, stats, wall0, opens, events) ->
             sl.window = w
 
 
+#: Outputs per mapped evaluation of the post-processing terms (bounds the memory of long runs).
+CHUNK = 256
+
+
 def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events) -> SimulationResult:
     model = form.model
-    n_f, n_s = form.n_f, form.n_s
-    parts = [split_state(form, x, z) for x, z in zip(xs, zs)]
-    q = np.tile(model.q0, (len(parts), 1))
-    v = np.zeros_like(q)
-    for k, p in enumerate(parts):
-        q[k, model.free] = form.to_physical(p["q"])
-        v[k, model.free] = form.to_physical(p["v"])
-    s = np.array([p["s"] for p in parts]).reshape(len(parts), n_s)
-    qs, vs = ca.MX.sym("q", n_f), ca.MX.sym("v", n_f)
-    ss, ws, ts = ca.MX.sym("s", n_s), ca.MX.sym("w", n_s), ca.MX.sym("t")
-    scs = ca.MX.sym("sc", form.n_sc)
-    if form.formulation == "embedded" and n_s:
-        k = form.embedded_terms(qs, vs, ss, ts, scs)
-        s_dot_expr = k["s_dot"]
-    else:
-        s_dot_expr = ws
-    kk = form.terms(qs, vs, ss, s_dot_expr, ts, scs)
-    qf = form.q_fixed + ca.mtimes(form.P, qs)
-    vf = ca.mtimes(form.P, vs)
-    energy = ca.Function("e", [qs, vs], [model.kinetic_energy(qf, vf), model.potential_energy(qf)])
-    drift = ca.Function("d", [qs, vs, ss, ws, ts, scs], [kk["C"], ca.mtimes(kk["Cq"], vs) + ca.mtimes(kk["Cs"], s_dot_expr) + kk["Ct"],
-                                                        s_dot_expr, kk["Cq"], kk["Cs"], kk["M"], kk["Q"], kk["Qd"],
-                                                        kk["gap"], kk["fc"]])
-    n_sc = form.n_sc
-    sc = np.array([p.get("sc", np.zeros(0)) for p in parts]).reshape(len(parts), n_sc)
-    gaps, contact_forces = np.zeros((len(parts), n_sc)), np.zeros((len(parts), n_sc))
+    state = _stacked_state(form, xs, zs)
+    n_t = state["q"].shape[0]
+    q, v = _physical(form, state["q"], model.q0), _physical(form, state["v"], np.zeros(model.n_q))
+    post = _PostTerms(form)
+    n_w = len(model.wheelrail)
+    gaps, contact_forces = np.zeros((n_t, form.n_sc)), np.zeros((n_t, form.n_sc))
     acc = np.zeros_like(q)
-    lam = np.zeros((len(parts), model.n_c))
-    s_dot = np.zeros((len(parts), n_s))
-    normal_rows = [e.row_start + GAP_ROW for e in model.wheelrail]  # the gap rows (lam: augmented layout)
-    creep_record = np.zeros((len(parts), 6 * len(model.wheelrail)))
-    wheel_gap = np.zeros((len(parts), len(model.wheelrail)))
-    creep_fn = form.creep_function() if model.wheelrail else None
-    pos, vel, kin, pot = (np.zeros(len(parts)) for _ in range(4))
-    reactions = {name.split("[")[0]: np.zeros((len(parts), 3)) for name in model.row_names}
-    for i, (p, ti) in enumerate(zip(parts, t)):
-        w = p.get("w", np.zeros(n_s))
-        c, cdot, sd, cq, cs, mass, force, qd, gap, fc = drift(p["q"], p["v"], p["s"], w, ti, sc[i])
-        gaps[i], contact_forces[i] = np.asarray(gap).ravel(), np.asarray(fc).ravel()
-        s_dot[i] = np.asarray(sd).ravel()
-        closed = np.setdiff1d(np.arange(model.n_c), form.open_rows(opens[i]) if model.wheelrail else [])
-        c = np.asarray(c).ravel()
-        wheel_gap[i] = [c[e.row_start + GAP_ROW] if e.joint.form == "railframe"
-                        else e.contact.gap(q[i, e.rows], p["s"][e.s_index : e.s_index + 4]) for e in model.wheelrail]
-        pos[i] = np.abs(c[closed]).max(initial=0.0)
-        vel[i] = np.abs(np.asarray(cdot).ravel()[closed]).max(initial=0.0)
-        # Multipliers from the KKT system at each output (exact for the state, whatever IDAS's
-        # tolerance on algebraic variables): the same for every formulation.
+    lam = np.zeros((n_t, model.n_c))
+    s_dot = np.zeros((n_t, form.n_s))
+    creep_record = np.zeros((n_t, 6 * n_w))
+    wheel_gap = np.zeros((n_t, n_w))
+    pos, vel, kin, pot = (np.zeros(n_t) for _ in range(4))
+    reactions = {name: np.zeros((n_t, 3)) for name in post.reactions.names}
+    open_rows = [tuple(form.open_rows(opens[i])) if n_w else () for i in range(n_t)]  # lifted-off contacts
+    t_in = np.asarray(t, float)[:n_t].reshape(n_t, 1)
+    for lo in range(0, n_t, CHUNK):
+        rows = slice(lo, min(lo + CHUNK, n_t))
+        chunk = {name: x[rows] for name, x in state.items()}
+        terms = post.evaluate(chunk, t_in[rows])
+        gaps[rows], contact_forces[rows], s_dot[rows] = terms["gap"], terms["fc"], terms["s_dot"]
+        kin[rows], pot[rows] = terms["kinetic"][:, 0], terms["potential"][:, 0]
+        closed = _closed_mask(model.n_c, open_rows[rows])
+        pos[rows], vel[rows] = _max_abs(terms["C"], closed), _max_abs(terms["C_dot"], closed)
+        wheel_gap[rows] = _wheel_gaps(model, q[rows], chunk["s"], terms["C"])
         if model.n_c:
-            creep = CreepCoupling(form, p["q"], p["v"], p["s"], s_dot[i], normal_rows)
-            mass_i, cq_i = to_scipy(mass), to_scipy(cq).tocsr()[closed].tocsc()
-            cs_i, qd_i = np.asarray(ca.densify(cs))[closed], np.asarray(qd).ravel()[closed]
-            solve = kkt_solver_closed(mass_i, cq_i, cs_i, closed, model.n_c)
-            a_i, _, lam[i] = creep.solve(lambda f: solve(f, qd_i), np.asarray(force).ravel())
-            if creep.active:
-                creep_record[i] = np.asarray(creep_fn(p["q"], p["v"], p["s"], s_dot[i], -lam[i][normal_rows])[1]).ravel()
+            # Multipliers from the KKT system at each output (exact for the state, whatever
+            # IDAS's tolerance on algebraic variables): the same for every formulation.
+            a, lam[rows], creep_record[rows] = post.multipliers(chunk, terms, open_rows[rows])
         else:
-            a_i = spla.spsolve(to_scipy(mass).tocsc(), np.asarray(force).ravel()) if n_f else np.zeros(0)
-        acc[i, model.free] = form.to_physical(np.atleast_1d(a_i))
-        e_k, e_p = energy(p["q"], p["v"])
-        kin[i], pot[i] = float(e_k), float(e_p)
-        _reactions(model, form, np.asarray(ca.densify(cq)), lam[i], reactions, i)
+            a = post.accelerations(terms)
+        for i, a_i in zip(range(rows.start, rows.stop), a):
+            acc[i, model.free] = form.to_physical(np.atleast_1d(a_i))
+        for name, force in post.reactions(terms["Cq"], lam[rows]).items():
+            reactions[name][rows] = force
     wall = time.perf_counter() - wall0
     stats = {**stats, "wall_s": wall, "steps": stats.get("nsteps", 0)}
+    s, sc = state["s"], state["sc"]
     return SimulationResult(
         t_s=np.asarray(t), q=q, v=v, s_m=s, s_dot_m_s=s_dot, multipliers=lam, row_names=model.row_names,
         coordinate_names=model.coordinate_names(), reactions_N=reactions,
@@ -187,6 +163,155 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events) -> Simul
     )
 
 
+def _stacked_state(form: Formulation, xs, zs) -> dict:
+    """The integrator's outputs split as :func:`split_state` does, one row per output:
+    ``q``, ``v``, ``s``, ``w`` (zero where the state has none) and ``sc``."""
+    xb, zb = form.blocks()
+    n_t = len(xs)
+    x = np.asarray(xs, float).reshape(n_t, sum(b.size for b in xb.values()))
+    z = np.asarray(zs, float).reshape(n_t, sum(b.size for b in zb.values()))
+    out = {k: x[:, b.slice] for k, b in xb.items()}
+    out.update({k: z[:, b.slice] for k, b in zb.items() if k not in out})
+    sizes = {"q": form.n_f, "v": form.n_f, "s": form.n_s, "w": form.n_s, "sc": form.n_sc}
+    return {k: out.get(k, np.zeros((n_t, n))) for k, n in sizes.items()}
+
+
+def _physical(form: Formulation, y: np.ndarray, fixed: np.ndarray) -> np.ndarray:
+    """All coordinates (fixed ones from ``fixed``) from the DAE's free ones, one row per output."""
+    model = form.model
+    out = np.tile(fixed, (y.shape[0], 1))
+    for k, y_k in enumerate(y):
+        out[k, model.free] = form.to_physical(y_k)
+    return out
+
+
+def _closed_mask(n_c: int, open_rows) -> np.ndarray:
+    """(n, n_c) True on the closed constraint rows of each output."""
+    mask = np.ones((len(open_rows), n_c), bool)
+    for i, rows in enumerate(open_rows):
+        mask[i, list(rows)] = False
+    return mask
+
+
+def _max_abs(values: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """Max-norm of each row over its ``mask`` entries (zero if none)."""
+    return np.where(mask, np.abs(values), 0.0).max(axis=1, initial=0.0)
+
+
+def _wheel_gaps(model, q: np.ndarray, s: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Normal gap of every wheel/rail contact: the gap row of eq. 22 (railframe), else from the
+    contact's geometry."""
+    gaps = np.zeros((q.shape[0], len(model.wheelrail)))
+    for k, e in enumerate(model.wheelrail):
+        if e.joint.form == "railframe":
+            gaps[:, k] = c[:, e.row_start + GAP_ROW]
+        else:
+            gaps[:, k] = [e.contact.gap(q_i[e.rows], s_i[e.s_index : e.s_index + 4]) for q_i, s_i in zip(q, s)]
+    return gaps
+
+
+class _Mapped:
+    """A CasADi function of column vectors evaluated for many inputs in one call
+    (``Function.map``, built once per batch size): inputs and outputs with one row per
+    evaluation."""
+
+    def __init__(self, fn: ca.Function):
+        self.fn, self._maps = fn, {}
+        self._sizes = [fn.sparsity_out(i).numel() for i in range(fn.n_out())]
+        if any(fn.sparsity_out(i).size2() != 1 and size for i, size in enumerate(self._sizes)):
+            raise ValueError(f"{fn.name()}: the outputs must be column vectors to be mapped row-wise")
+
+    def __call__(self, *rows) -> list[np.ndarray]:
+        n = rows[0].shape[0]
+        if n not in self._maps:
+            self._maps[n] = self.fn.map(n)
+        out = self._maps[n](*(np.asarray(r, float).T for r in rows))
+        # reshape: an empty output may come back 0 x 0
+        return [np.asarray(o).reshape(size, n).T for o, size in zip(out, self._sizes)]
+
+
+class _PostTerms:
+    """The per-output terms of a formulation (constraints, drifts, mass matrix, forces, energies;
+    sparse matrices as their nonzeros) and what follows from them: multipliers, accelerations,
+    creep records and joint reactions. The sparsity patterns are the same at every output, so
+    the KKT matrices and reactions are assembled by index maps built once."""
+
+    def __init__(self, form: Formulation):
+        from ..assembly.wheelrail import has_creep
+
+        self.form = form
+        model = form.model
+        fn, self.patterns = _terms_function(form)
+        self._terms, self._names = _Mapped(fn), fn.name_out()
+        self.creep = _Mapped(form.creep_function()) if has_creep(model) else None
+        self.normal_rows = [e.row_start + GAP_ROW for e in model.wheelrail]  # the gap rows (augmented layout)
+        self._kkt = {}  # open rows -> KKTPattern
+        self.reactions = _ReactionMap(model, self.patterns["Cq"])
+
+    def evaluate(self, state: dict, t: np.ndarray) -> dict:
+        """The terms (n, size) of the outputs of ``state`` (internal coordinates) at times ``t``."""
+        out = self._terms(state["q"], state["v"], state["s"], state["w"], t, state["sc"])
+        return dict(zip(self._names, out))
+
+    def multipliers(self, state: dict, terms: dict, open_rows) -> tuple:
+        """Accelerations (free, internal), multipliers (n, n_c) and creep records (n, 6 n_w) from
+        the KKT system of every output (creep forces settled with the normal forces)."""
+        solves = [self._solver(terms, i, rows) for i, rows in enumerate(open_rows)]
+        n = len(solves)
+        if self.creep is None:
+            outs = [solve(f) for solve, f in zip(solves, terms["Q"])]
+            lam = np.array([out[2] for out in outs]).reshape(n, self.form.n_c)
+            return [out[0] for out in outs], lam, np.zeros((n, 6 * len(self.normal_rows)))
+        args = (state["q"], state["v"], state["s"], terms["s_dot"])
+        outs = settle_creep(solves, terms["Q"], lambda normal: self.creep(*args, normal)[0], self.normal_rows)
+        lam = np.array([out[2] for out in outs]).reshape(n, self.form.n_c)
+        return [out[0] for out in outs], lam, self.creep(*args, -lam[:, self.normal_rows])[1]
+
+    def _solver(self, terms: dict, i: int, open_rows):
+        """``solve(force)`` of output ``i``'s KKT system, its rows ``open_rows`` released."""
+        if open_rows not in self._kkt:
+            closed = np.setdiff1d(np.arange(self.form.model.n_c), open_rows)
+            self._kkt[open_rows] = KKTPattern(self.patterns["M"], self.patterns["Cq"], self.patterns["Cs"], closed)
+        pattern = self._kkt[open_rows]
+        solve = pattern.solver(terms["M"][i], terms["Cq"][i], terms["Cs"][i])
+        qd = terms["Qd"][i][pattern.closed]
+        return lambda force: solve(force, qd)
+
+    def accelerations(self, terms: dict) -> list:
+        """Accelerations (free, internal) of unconstrained outputs: ``M a = Q``."""
+        n_f = self.form.n_f
+        if not n_f:
+            return [np.zeros(0) for _ in terms["Q"]]
+        colind, row = (np.asarray(x) for x in self.patterns["M"].get_ccs())
+        return [spla.spsolve(sps.csc_matrix((m_nz, row, colind), shape=(n_f, n_f)), f)
+                for m_nz, f in zip(terms["M"], terms["Q"])]
+
+
+def _terms_function(form: Formulation) -> tuple[ca.Function, dict]:
+    """One output's terms as a function of ``(q, v, s, w, t, sc)``: ``C``, its rate ``C_dot``,
+    ``s_dot``, the nonzeros of ``Cq``, ``Cs`` and ``M``, ``Q``, ``Qd``, contact ``gap`` and ``fc``,
+    ``kinetic`` and ``potential`` energy; and the patterns of the sparse matrices."""
+    model = form.model
+    n_f, n_s = form.n_f, form.n_s
+    qs, vs = ca.MX.sym("q", n_f), ca.MX.sym("v", n_f)
+    ss, ws, ts = ca.MX.sym("s", n_s), ca.MX.sym("w", n_s), ca.MX.sym("t")
+    scs = ca.MX.sym("sc", form.n_sc)
+    if form.formulation == "embedded" and n_s:
+        s_dot = form.embedded_terms(qs, vs, ss, ts, scs)["s_dot"]
+    else:
+        s_dot = ws
+    kk = form.terms(qs, vs, ss, s_dot, ts, scs)
+    qf = form.q_fixed + ca.mtimes(form.P, qs)
+    vf = ca.mtimes(form.P, vs)
+    sparse = {"Cq": kk["Cq"], "Cs": kk["Cs"], "M": kk["M"]}
+    outs = {"C": kk["C"], "C_dot": ca.mtimes(kk["Cq"], vs) + ca.mtimes(kk["Cs"], s_dot) + kk["Ct"], "s_dot": s_dot,
+            **{name: ca.vec(x.nz[:]) for name, x in sparse.items()}, "Q": kk["Q"], "Qd": kk["Qd"], "gap": kk["gap"],
+            "fc": kk["fc"], "kinetic": model.kinetic_energy(qf, vf), "potential": model.potential_energy(qf)}
+    fn = ca.Function("post", [qs, vs, ss, ws, ts, scs], list(outs.values()),
+                     ["q", "v", "s", "w", "t", "sc"], list(outs))
+    return fn, {name: x.sparsity() for name, x in sparse.items()}
+
+
 def _normal_force(entry, lam) -> np.ndarray:
     """Normal force (N) of a wheel/rail contact from the multipliers: minus that of the gap row
     (eq. 22), or, for eq. 21 (frictionless), the magnitude of the three distance rows' force."""
@@ -196,28 +321,70 @@ def _normal_force(entry, lam) -> np.ndarray:
     return -np.sign(rows[:, 2]) * np.linalg.norm(rows, axis=1)
 
 
-def _reactions(model, form, cq_free, lam, reactions, i):
-    """Constraint force on body j of each joint: -(C_q rows of body j's first 3 coordinates)^T lambda
-    (for joints to the ground, minus the force on body i)."""
-    full = np.zeros((cq_free.shape[0], model.n_q))
-    full[:, model.free] = cq_free
-    names = [n.split("[")[0] for n in model.row_names]
-    for name in reactions:
-        rows = [r for r, n in enumerate(names) if n == name]
-        gen = -full[rows].T @ lam[rows]
-        reactions[name][i] = _force_on_j(model, name, gen)
+class _ReactionMap:
+    """Constraint force on each joint's reporting body (:func:`_reporting_body`):
+    ``-(C_q rows of the joint, columns of the body's first 3 coordinates)^T lambda``, from the
+    nonzeros of ``C_q`` (free columns, pattern ``cq``) by index maps built once."""
+
+    def __init__(self, model, cq: ca.Sparsity):
+        self.names = list(dict.fromkeys(n.split("[")[0] for n in model.row_names))
+        slots = {}  # (joint, coordinate) -> (position in the (n_joint, 3) output, sign)
+        for j, name in enumerate(self.names):
+            body = _reporting_body(model, name)
+            if body is not None:
+                sign, ref = body
+                slots.update({(j, col): (3 * j + axis, sign) for axis, col in enumerate(_first3(model, ref))})
+        position = {name: j for j, name in enumerate(self.names)}
+        joint_of_row = [position[n.split("[")[0]] for n in model.row_names]
+        rows, cols = cq.get_triplet()
+        hits = [(e, r, slots[joint_of_row[r], model.free[c]]) for e, (r, c) in enumerate(zip(rows, cols))
+                if (joint_of_row[r], model.free[c]) in slots]
+        self._nz = np.array([e for e, _, _ in hits], int)
+        self._rows = np.array([r for _, r, _ in hits], int)
+        self._select = np.zeros((len(hits), 3 * len(self.names)))
+        for h, (_, _, (slot, sign)) in enumerate(hits):
+            self._select[h, slot] = -sign
+
+    def __call__(self, cq_nz: np.ndarray, lam: np.ndarray) -> dict:
+        """Joint name -> (n, 3) forces for the nonzeros ``cq_nz`` (n, nnz) and multipliers ``lam``
+        (n, n_c) of n states."""
+        forces = (cq_nz[:, self._nz] * lam[:, self._rows]) @ self._select
+        return {name: forces[:, 3 * j : 3 * j + 3] for j, name in enumerate(self.names)}
 
 
-def _force_on_j(model, name, gen):
-    """Force on the joint's reporting body: ``body`` of sliding and driving joints, ``body_j``
-    of two-body joints, or the ground (minus the force on ``body_i``)."""
+def joint_reactions(model, cq_free, lam) -> dict:
+    """Joint reactions of one state (see :class:`SimulationResult`).
+
+    Parameters
+    ----------
+    model : MultibodyModel
+    cq_free : ndarray (n_c, n_f)
+        Dense constraint Jacobian in the free coordinates.
+    lam : ndarray (n_c,)
+        Multipliers.
+
+    Returns
+    -------
+    dict
+        Joint name -> (3,) force (N).
+    """
+    cq_free = np.asarray(cq_free)
+    reaction_map = _ReactionMap(model, ca.Sparsity.dense(*cq_free.shape))
+    forces = reaction_map(cq_free.ravel(order="F")[None, :], np.asarray(lam)[None, :])  # CCS order
+    return {name: force[0] for name, force in forces.items()}
+
+
+def _reporting_body(model, name):
+    """``(sign, body)``: the force on the joint is ``sign`` times that on ``body`` -- ``body`` of
+    sliding and driving joints, ``body_j`` of two-body joints, or minus the force on ``body_i``
+    for joints to the ground; None for rows of no joint (Euler-parameter normalization)."""
     joint = next((j for j in model.scene.joints if j.name == name), None)
-    if joint is None:  # Euler-parameter normalization rows carry no force
-        return np.zeros(3)
+    if joint is None:
+        return None
     ref = getattr(joint, "body", None) or joint.body_j
     if ref == "ground":
-        return -gen[_first3(model, joint.body_i)]
-    return gen[_first3(model, ref)]
+        return -1.0, joint.body_i
+    return 1.0, ref
 
 
 def _first3(model, ref):
