@@ -176,7 +176,7 @@ def relative_curvature(contact, q, s, kernels=None) -> float:
     k = contact.evaluate(q, s, clip=True) if kernels is None else kernels
     t = k.C_s
     rows, cols = [0, 1, 4], [1, 2, 3]
-    reduced = t[3, 0] - t[3, cols] @ np.linalg.solve(t[np.ix_(rows, cols)], t[rows, 0])
+    reduced = t[3, 0] - t[3, cols] @ np.linalg.solve(t[rows][:, cols], t[rows, 0])
     return float(reduced / np.hypot(*contact.wheel.derivative(s[0])))
 
 
@@ -192,9 +192,12 @@ def halving_time(contact, s, s_rate, kappa: float, samples: int = 64) -> float:
     tau = np.linspace(0.0, TRAVEL_M / abs(s_rate[0]), samples + 1)[1:]
     w = np.clip(s[0] + s_rate[0] * tau, contact.wheel.s_min, contact.wheel.s_max)
     r = np.clip(s[3] + s_rate[3] * tau, contact.rail.s_min, contact.rail.s_max)
-    path = -(contact.wheel.curvature(w) + contact.rail.curvature(r))
+    # One evaluation per profile: the point's own curvature first, then the path's.
+    k_w = contact.wheel.curvature(np.concatenate(([s[0]], w)))
+    k_r = contact.rail.curvature(np.concatenate(([s[3]], r)))
+    path = -(k_w[1:] + k_r[1:])
     # The path's curvatures are relative to the point's own (3D effects: roll, yaw).
-    path += kappa + (contact.wheel.curvature(s[0]) + contact.rail.curvature(s[3]))
+    path += kappa + (k_w[0] + k_r[0])
     low = np.flatnonzero(path <= max(0.5 * kappa, FOLD_CURVATURE_PER_M))
     return float(tau[low[0]]) if low.size else math.inf
 

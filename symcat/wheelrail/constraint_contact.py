@@ -24,8 +24,10 @@ layout (0 to its length).
 """
 from __future__ import annotations
 
+import bisect
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -75,9 +77,18 @@ class ContactKernels:
     Q_d: np.ndarray | None = None
 
 
+def _described(name: str, doc: str) -> property:
+    """A :class:`ContactPoint` attribute taken from its description (computed on first access)."""
+    return property(lambda self: self._description[name], doc=doc)
+
+
 @dataclass
 class ContactPoint:
     """Solution of the contact-point problem for a given wheelset position.
+
+    The geometric description (radius, angle, lateral positions, point, normal) is computed on
+    first access: the searches for local minima (:mod:`.gap_minima`) solve many points and use
+    only their parameters and gaps.
 
     Attributes
     ----------
@@ -86,6 +97,12 @@ class ContactPoint:
     gap_m : float
         Normal gap along the rail's outward normal [m] (positive: separated, negative:
         penetration); the fifth constraint's value.
+    residual : float
+        Largest absolute value of the four conditions solved.
+    iterations : int
+        Newton iterations.
+    contact : WheelRailContact
+        The contact solved (it describes the point).
     rolling_radius_m : float
         Wheel radius at the contact point [m].
     contact_angle_rad : float
@@ -97,26 +114,27 @@ class ContactPoint:
         Contact point on the rail, global [m].
     normal : ndarray (3,)
         Unit outward normal of the rail, global.
-    residual : float
-        Largest absolute value of the four conditions solved.
-    iterations : int
-        Newton iterations.
     """
 
     s: np.ndarray
     gap_m: float
-    rolling_radius_m: float
-    contact_angle_rad: float
-    wheel_y_m: float
-    rail_y_m: float
-    point_m: np.ndarray
-    normal: np.ndarray
     residual: float
     iterations: int
+    contact: WheelRailContact = field(repr=False, compare=False)
 
+    def __post_init__(self):
+        self._solved_s = np.array(self.s, float)  # described as solved, whatever becomes of s
 
-def _np(x) -> np.ndarray:
-    return np.asarray(x.full() if hasattr(x, "full") else x, float)
+    @cached_property
+    def _description(self) -> dict:
+        return self.contact._describe(self._solved_s)
+
+    rolling_radius_m = _described("rolling_radius_m", "Wheel radius at the contact point [m].")
+    contact_angle_rad = _described("contact_angle_rad", "Inclination of the common tangent to the track plane [rad].")
+    wheel_y_m = _described("wheel_y_m", "Lateral coordinate of the contact point on the wheel profile [m].")
+    rail_y_m = _described("rail_y_m", "Lateral coordinate of the contact point on the rail profile [m].")
+    point_m = _described("point_m", "Contact point on the rail, global [m].")
+    normal = _described("normal", "Unit outward normal of the rail, global.")
 
 
 class WheelRailContact:
@@ -183,7 +201,12 @@ class WheelRailContact:
         self._rpp = rail.piecewise_polynomial()
         self._head = np.r_[self.sign, self.wheelset.nominal_radius_m, 0.5 * self.wheelset.tape_circle_distance_m,
                            self.frames.head]
+        # Breakpoints as lists (bisect on a float is 10x faster than np.searchsorted) and the
+        # kernel parameters of each profile piece: start and the coefficients of y and z.
+        self._wx, self._rx = self._wpp.x.tolist(), self._rpp.x.tolist()
+        self._wheel_rows, self._rail_rows = _piece_rows(self._wpp), _piece_rows(self._rpp)
         self._kernels = None
+        self._buffered = {}
 
     # ------------------------------------------------------------------ kernels
     @property
@@ -194,13 +217,30 @@ class WheelRailContact:
             self._kernels = kernel_library(self.library)
         return self._kernels
 
+    def _kernel(self, suffix: str):
+        """The kernel ``<library>_<suffix>`` as a :class:`BufferedFunction` (one per contact:
+        it owns its buffers)."""
+        f = self._buffered.get(suffix)
+        if f is None:
+            from symcat.codegen.library import BufferedFunction
+
+            f = self._buffered[suffix] = BufferedFunction(self.kernels[f"{self.library}_{suffix}"])
+        return f
+
     @staticmethod
-    def _piece(pp, s: float, label: str, profile: Profile, clip: bool) -> int:
-        x = pp.x
+    def _piece(x: list, s: float, label: str, profile: Profile, clip: bool) -> int:
+        """Index of the piece of breakpoints ``x`` holding ``s`` (the end pieces extend them)."""
         if not clip and not (x[0] - 1e-9 <= s <= x[-1] + 1e-9):
             raise ParameterError(f"{label}={s:.6g} m: outside the {profile.kind} profile {profile.name!r} "
                                  f"(allowed {x[0]:.6g} to {x[-1]:.6g} m)")
-        return int(np.clip(np.searchsorted(x, s, side="right") - 1, 0, len(x) - 2))
+        return min(max(bisect.bisect_right(x, s) - 1, 0), len(x) - 2)
+
+    def _check_inside(self, s) -> None:
+        """Raise :class:`ParameterError` if ``s`` leaves a profile or the track (as
+        :meth:`parameters` without ``clip``)."""
+        self._piece(self._wx, s[0], "s1w", self.wheel, False)
+        self._piece(self._rx, s[3], "s2r", self.rail, False)
+        self.frames.check(s[2])
 
     def parameters(self, s, *, pieces: tuple[int, int] | None = None, clip: bool = False) -> np.ndarray:
         """Kernel parameters (24, curved track 46) for surface parameters ``s``: the spline pieces
@@ -214,18 +254,16 @@ class WheelRailContact:
         """
         s = np.asarray(s, float)
         if pieces is None:
-            iw = self._piece(self._wpp, s[0], "s1w", self.wheel, clip)
-            ir = self._piece(self._rpp, s[3], "s2r", self.rail, clip)
+            iw = self._piece(self._wx, s[0], "s1w", self.wheel, clip)
+            ir = self._piece(self._rx, s[3], "s2r", self.rail, clip)
         else:
             iw, ir = pieces
-        cw, cr = self._wpp.c[:, iw, :], self._rpp.c[:, ir, :]
-        return np.r_[self._head, self._wpp.x[iw], cw[:, 0], cw[:, 1], self._rpp.x[ir], cr[:, 0], cr[:, 1],
-                     self.frames.params(s[2], clip)]
+        return np.concatenate((self._head, self._wheel_rows[iw], self._rail_rows[ir], self.frames.params(s[2], clip)))
 
     def residual(self, q, s, t: float = 0.0, **kw) -> np.ndarray:
         """The five constraints ``C(q, s)``."""
-        y = np.r_[np.asarray(q, float), np.asarray(s, float)]
-        return _np(self.kernels[f"{self.library}_c"](y, t, self.parameters(s, **kw))).ravel()
+        y = np.concatenate((np.asarray(q, float), np.asarray(s, float)))
+        return self._kernel("c")(y, t, self.parameters(s, **kw))[0].ravel()
 
     def gap(self, q, s, kernels=None) -> float:
         """Normal gap (m) at surface parameters ``s`` as they are (no solve): the gap row of
@@ -241,16 +279,14 @@ class WheelRailContact:
         q, s = np.asarray(q, float), np.asarray(s, float)
         if q.shape != (7,) or s.shape != (4,):
             raise ParameterError(f"q, s: shapes {q.shape}, {s.shape}; must be (7,) and (4,)")
-        y = np.r_[q, s]
+        y = np.concatenate((q, s))
         p = self.parameters(s, **kw)
-        lib = self.kernels
-        c = _np(lib[f"{self.library}_c"](y, t, p)).ravel()
-        c_y, c_t = (_np(m) for m in lib[f"{self.library}_jac"](y, t, p))
-        c_y = c_y.reshape(5, 11)
+        c = self._kernel("c")(y, t, p)[0].ravel()
+        c_y, c_t = self._kernel("jac")(y, t, p)
         q_d = None
         if q_dot is not None or s_dot is not None:
             y_dot = np.r_[np.zeros(7) if q_dot is None else q_dot, np.zeros(4) if s_dot is None else s_dot]
-            q_d = _np(lib[f"{self.library}_gamma"](y, y_dot, t, p)).ravel()
+            q_d = self._kernel("gamma")(y, y_dot, t, p)[0].ravel()
         return ContactKernels(c, c_y[:, :7], c_y[:, 7:], c_t.ravel(), q_d)
 
     # ------------------------------------------------------------------ contact point
@@ -299,22 +335,19 @@ class WheelRailContact:
 
         return gap_minima(self, q, band_m, grid_m, near, known)
 
-    def _vertical_gap(self, q, a, s2w, s1w, s_guess):
+    def _vertical_gap(self, q, a, s2w, s1w, s_guess, pw=None):
         """Gap along the rail profile's ``z`` of the wheel points ``(s1w, s2w)``, the rail
-        parameter below each, and the chainage of its cross-section."""
-        pw = self.wheel.position(s1w)
+        parameter below each, and the chainage of its cross-section. ``pw``: the wheel profile's
+        points at ``s1w``, if at hand."""
+        pw = self.wheel.position(s1w) if pw is None else pw
         rho = self._head[1] + pw[:, 1]
         u = np.stack([rho * np.sin(s2w), self.sign * (self._head[2] + pw[:, 0]), -rho * np.cos(s2w)])
         points = (q[:3, None] + a @ u).T
         s1r = self.frames.project(points, s_guess)
         R, A, _, _ = self.frames.frames(s1r)
         local = np.einsum("nji,nj->in", A, points - R)  # A^T (p - R) in the profile frame
-        y_r = self.sign * local[1]
-        s2r = self.rail.s_at(y_r)
-        z_r = np.full(len(s1w), np.nan)
-        ok = np.isfinite(s2r)
-        z_r[ok] = self.rail.position(s2r[ok])[:, 1]
-        return local[2] - z_r, s2r, s1r
+        s2r, z_r = self.rail.envelope_at(self.sign * local[1])
+        return local[2] - np.where(np.isfinite(s2r), z_r, np.nan), s2r, s1r
 
     def solve(self, q, s_guess=None, *, tol: float = 1e-13, max_iter: int = 40, local: bool = False) -> ContactPoint:
         """Contact point of the wheelset at ``q``: the four surface parameters from the two
@@ -346,8 +379,8 @@ class WheelRailContact:
     def _newton(self, q, s, tol, max_iter) -> ContactPoint:
         lo = np.array([self.wheel.s_min, -math.pi, -np.inf, self.rail.s_min])
         hi = np.array([self.wheel.s_max, math.pi, np.inf, self.rail.s_max])
-        x = np.r_[s, 0.0]  # surface parameters and (global form) the gap
-        f, jac = self._conditions(q, x)
+        x = np.append(s, 0.0)  # surface parameters and (global form) the gap
+        f, jac, k = self._conditions(q, x)
         res = float(np.abs(f).max())
         for it in range(1, max_iter + 1):
             try:
@@ -356,26 +389,28 @@ class WheelRailContact:
                 raise SolverError(f"{self.side} wheel: singular contact Jacobian C_s at s={x[:4]} (the wheel "
                                   "and rail tangent planes cannot be matched there)") from None
             if step.size == 4:
-                step = np.r_[step, 0.0]
+                step = np.append(step, 0.0)
             scale = min(1.0, float(np.min(MAX_STEP / np.maximum(np.abs(step[:4]), 1e-300))))
             # Backtracking on |f|: Newton on the stationarity conditions may overshoot where the
             # profiles are nearly conformal.
             alpha = scale
             for _ in range(12):
-                x_new = np.r_[np.clip(x[:4] + alpha * step[:4], lo, hi), x[4] + alpha * step[4]]
-                f_new, jac_new = self._conditions(q, x_new)
+                x_new = np.append(np.clip(x[:4] + alpha * step[:4], lo, hi), x[4] + alpha * step[4])
+                f_new, jac_new, k_new = self._conditions(q, x_new)
                 res_new = float(np.abs(f_new).max())
                 if res_new <= (1 - 1e-4 * alpha) * res or res_new <= tol:
                     break
                 alpha *= 0.5
-            x, f, jac, res = x_new, f_new, jac_new, res_new
+            x, f, jac, k, res = x_new, f_new, jac_new, k_new, res_new
             if res <= tol or (alpha == 1.0 and np.abs(step[:4]).max() < 1e-14):
                 break
         else:
             raise SolverError(f"{self.side} wheel: contact point not found in {max_iter} Newton iterations "
                               f"(residual {res:.3g}) at q={np.array2string(q, precision=5)}")
         s = x[:4]
-        k = self.evaluate(q, s)  # raises ParameterError if the point left a profile
+        # k are the kernels at s; their pieces are those of an unclipped evaluation unless the
+        # point left a profile or the track.
+        self._check_inside(s)
         if self.form == "railframe":
             gap, res = float(k.c[2]), float(np.abs(k.c[[0, 1, 3, 4]]).max())
         else:
@@ -384,26 +419,27 @@ class WheelRailContact:
             res = float(np.abs(np.r_[k.c[:3] - gap * n, k.c[3:]]).max())
         if not res < 1e-8:
             raise SolverError(f"{self.side} wheel: Newton stalled at residual {res:.3g} (s={s})")
-        return self._describe(s, gap, res, it)
+        return ContactPoint(np.array(s, float), gap, res, it, self)
 
     def _conditions(self, q, x):
-        """The four (rail frame) or five (global, with the gap ``x[4]``) conditions and their
-        Jacobian in ``x``."""
+        """The four (rail frame) or five (global, with the gap ``x[4]``) conditions, their
+        Jacobian in ``x`` and the kernels at ``x[:4]``."""
         k = self.evaluate(q, x[:4], clip=True)
         if self.form == "railframe":
-            return k.c[[0, 1, 3, 4]], k.C_s[[0, 1, 3, 4]]
+            return k.c[[0, 1, 3, 4]], k.C_s[[0, 1, 3, 4]], k
         n = self._normal_from_jacobian(k.C_s)
         jac = np.zeros((5, 5))
         jac[:, :4] = k.C_s  # the normal's dependence on s2r is left out (exact at zero gap)
         jac[:3, 4] = -n
-        return k.c - np.r_[x[4] * n, 0.0, 0.0], jac
+        return k.c - np.r_[x[4] * n, 0.0, 0.0], jac, k
 
     def _normal_from_jacobian(self, c_s: np.ndarray) -> np.ndarray:
         # Rows 1-3 of eq. 21 are r^w - r^r: their s1r and s2r columns are -t1^r and -t2^r.
         n = self.sign * np.cross(-c_s[:3, 2], -c_s[:3, 3])
         return n / np.linalg.norm(n)
 
-    def _describe(self, s, gap, res, iterations) -> ContactPoint:
+    def _describe(self, s) -> dict:
+        """The geometric attributes of a :class:`ContactPoint` at surface parameters ``s``."""
         pw = self.wheel.position(s[0])
         pr, dr = self.rail.position(s[3]), self.rail.derivative(s[3])
         R, A, dR, dA = (v[0] for v in self.frames.frames(s[2]))
@@ -411,12 +447,15 @@ class WheelRailContact:
         normal = self.sign * np.cross(dR + dA @ u, A @ du)
         normal /= np.linalg.norm(normal)
         in_track = self.frames.track_axes(s[2]).T @ normal
-        return ContactPoint(
-            s=np.array(s, float), gap_m=float(gap), rolling_radius_m=float(self._head[1] + pw[1]),
-            contact_angle_rad=float(math.atan2(-self.sign * in_track[1], in_track[2])),
-            wheel_y_m=float(pw[0]), rail_y_m=float(pr[0]), point_m=R + A @ u, normal=normal, residual=res,
-            iterations=iterations,
-        )
+        return dict(rolling_radius_m=float(self._head[1] + pw[1]),
+                    contact_angle_rad=float(math.atan2(-self.sign * in_track[1], in_track[2])),
+                    wheel_y_m=float(pw[0]), rail_y_m=float(pr[0]), point_m=R + A @ u, normal=normal)
+
+
+def _piece_rows(pp) -> np.ndarray:
+    """Kernel parameters of each piece of a profile's piecewise cubic ``pp``: its start and the
+    coefficients of ``y`` and of ``z``, shape ``(pieces, 9)``."""
+    return np.column_stack([pp.x[:-1], pp.c[:, :, 0].T, pp.c[:, :, 1].T])
 
 
 def _rotation(theta) -> np.ndarray:

@@ -52,7 +52,8 @@ def gap_minima(contact, q, band_m: float = 2e-6, grid_m: float = 2.5e-4, near: f
     grid = np.linspace(lo, hi, max(int(math.ceil((hi - lo) / grid_m)), 8) + 1)
     if near is not None:
         grid = np.union1d(grid, np.clip(near + np.arange(-1.5e-3, 1.5e-3 + 1e-9, FINE_GRID_M), lo, hi))
-    gap, s2r, s1r = contact._vertical_gap(q, a, bottom, grid, s_axle)
+    pw = contact.wheel.position(grid)
+    gap, s2r, s1r = contact._vertical_gap(q, a, bottom, grid, s_axle, pw)
     gap = np.where(np.isfinite(gap), gap, np.inf)
     if not np.isfinite(gap).any():
         raise SolverError(f"{contact.side} wheel: no point of the wheel lies above the rail at "
@@ -65,7 +66,7 @@ def gap_minima(contact, q, band_m: float = 2e-6, grid_m: float = 2.5e-4, near: f
     d = contact.rail.derivative(s2r[on])
     with np.errstate(divide="ignore", invalid="ignore"):
         slope[on] = np.abs(d[:, 1] / d[:, 0])
-    radius = contact._head[1] + contact.wheel.position(grid)[:, 1]
+    radius = contact._head[1] + pw[:, 1]
     finite = np.isfinite(slope)
     lowering = np.full(len(grid), np.inf if sin_yaw != 0.0 else 0.0)
     lowering[finite] = 0.5 * radius[finite] * (slope[finite] * sin_yaw) ** 2
@@ -75,21 +76,23 @@ def gap_minima(contact, q, band_m: float = 2e-6, grid_m: float = 2.5e-4, near: f
     s2w = np.full(len(grid), bottom)
     if sin_yaw != 0.0 and candidate.any():
         step = 0.05  # rad
-        sub = grid[candidate]
-        g = [np.nan_to_num(contact._vertical_gap(q, a, bottom + k * step, sub, s_axle)[0], nan=np.inf)
-             for k in (-1, 1)]
+        sub, pw_sub = grid[candidate], pw[candidate]
+        # Both angles in one evaluation (its fixed cost exceeds that of the few circles).
+        angles = bottom + step * np.repeat([-1.0, 1.0], sub.size)
+        g = contact._vertical_gap(q, a, angles, np.tile(sub, 2), s_axle, np.tile(pw_sub, (2, 1)))[0]
+        g = np.nan_to_num(g, nan=np.inf).reshape(2, -1)
         with np.errstate(invalid="ignore", divide="ignore"):  # inf off the rail
             curv = g[0] + g[1] - 2 * gap[candidate]
             shift = np.where(curv > 0, 0.5 * step * (g[0] - g[1]) / curv, 0.0)
         s2w_sub = bottom + np.clip(np.nan_to_num(shift), -3 * step, 3 * step)
         moved = s2w_sub != bottom
         if moved.any():
-            gm, r2m, r1m = contact._vertical_gap(q, a, s2w_sub[moved], sub[moved], s_axle)
+            gm, r2m, r1m = contact._vertical_gap(q, a, s2w_sub[moved], sub[moved], s_axle, pw_sub[moved])
             idx = np.flatnonzero(candidate)[moved]
             better = np.isfinite(gm) & (gm < gap[idx])
             i = idx[better]
             gap[i], s2r[i], s1r[i], s2w[i] = gm[better], r2m[better], r1m[better], s2w_sub[moved][better]
-    lower = (gap <= np.r_[np.inf, gap[:-1]]) & (gap <= np.r_[gap[1:], np.inf])
+    lower = (gap <= np.concatenate(([np.inf], gap[:-1]))) & (gap <= np.concatenate((gap[1:], [np.inf])))
     points: list[ContactPoint] = []
     for j in np.flatnonzero(lower & (gap <= gap.min() + band_m)):
         if known is not None and abs(grid[j] - known) <= 1.5 * FINE_GRID_M:

@@ -202,6 +202,20 @@ def test_inclined_rails_and_cant(pairs):
                 assert abs(sc.contact_angle_rad - sol.contact_angle_rad) < 1e-10 and abs(sc.gap_m) < 1e-9
 
 
+def test_buffered_kernels_equal_casadi_calls(pairs):
+    """evaluate calls the kernels in preallocated buffers: the same values as CasADi's calls."""
+    pair = pairs["s1002_uic60"]
+    con = WheelRailContact(pair.wheel, pair.rail, "right", form="global")
+    q, s = np.r_[X0, 1e-3, 0.46, 1.0, 0.0, 0.0, 0.0], np.array([0.09, 0.01, X0, 0.066])
+    qd, sd = np.linspace(-1, 1, 7), np.array([1e-3, 37.0, 17.0, 1e-3])
+    k = con.evaluate(q, s, qd, sd)
+    y, p, lib = np.r_[q, s], con.parameters(s), con.kernels
+    c_y, c_t = (np.asarray(m) for m in lib[f"{con.library}_jac"](y, 0.0, p))
+    assert np.array_equal(k.c, np.asarray(lib[f"{con.library}_c"](y, 0.0, p)).ravel())
+    assert np.array_equal(np.hstack([k.C_q, k.C_s]), c_y) and np.array_equal(k.C_t, c_t.ravel())
+    assert np.array_equal(k.Q_d, np.asarray(lib[f"{con.library}_gamma"](y, np.r_[qd, sd], 0.0, p)).ravel())
+
+
 def _rot_x(a):
     c, s = math.cos(a), math.sin(a)
     return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])

@@ -108,6 +108,23 @@ def test_graph_lookup_round_trip_including_steep_faces():
     assert r.slope_at(-0.0435) > 10
 
 
+def test_envelope_lookup_equals_the_full_newton():
+    """s_at's Newton drops the points a step leaves unchanged (and keeps their last z): the
+    same bits as four full steps and a final evaluation."""
+    r = load_profile("UIC60_canted_1in40")
+    y = np.random.default_rng(3).uniform(*r.y_range, 500)
+    s, z = r.envelope_at(y)
+    lo, hi = r._pieces[0]
+    ys, ss = r._ytab[lo:hi + 1], r._stab[lo:hi + 1]
+    i = np.clip(np.searchsorted(ys, y) - 1, 0, len(ys) - 2)
+    ref = ss[i] + (y - ys[i]) / (ys[i + 1] - ys[i]) * (ss[i + 1] - ss[i])
+    for _ in range(4):
+        ref = np.clip(ref - (r.position(ref)[:, 0] - y) / r.derivative(ref)[:, 0], ss[i], ss[i + 1])
+    assert len(r._pieces) == 1
+    assert np.array_equal(s, ref) and np.array_equal(z, r.position(ref)[:, 1])
+    assert np.array_equal(r.s_at(y), s)
+
+
 def test_normals_point_out_of_the_material():
     r = load_profile("UIC60_canted_1in40")
     w = load_profile("S1002")
