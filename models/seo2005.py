@@ -129,6 +129,7 @@ def run(p: dict) -> ModelOutput:
         "contact_loss_percent": float(100.0 * lost.mean()),
         "max_position_drift_m": float(res.position_drift.max()),
         "max_velocity_drift_m_s": float(res.velocity_drift.max()),
+        "energy_change_J": float(res.energy_J["total"][-1] - res.energy_J["total"][0]),
         "contact_s_final_m": float(s_hist[-1]),
         "simulated_s": p["t_end"], "steps": res.stats["steps"], "wall_s": float(res.stats["wall_s"]),
         "wall_per_simulated_s": res.stats["wall_s"] / p["t_end"],

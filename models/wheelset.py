@@ -23,8 +23,9 @@ Summary
 ``normal_force_left_N``, ``normal_force_right_N``, ``rolling_radius_difference_m``
     At the static offset (t = 0): normal forces from the multipliers and ``r_left - r_right``.
 ``normal_force_min_N``
-    Smallest normal force of either wheel over the run (a run stops with an error if a wheel
-    would lift off or run off its rail: one bilateral contact point per wheel cannot separate).
+    Smallest normal force of either wheel over the run (0 while a wheel is lifted: the rail-frame
+    contacts open and land again, :mod:`symcat.integrate.contact_switching`; a wheel running off
+    its rail ends the run with an error).
 
 The contact point of each wheel jumps where another point of the profiles comes lower (see
 :mod:`symcat.integrate.contact_jumps`; ``contact_jumps`` in the statistics).

@@ -165,6 +165,17 @@ class ContactCheck:
             spans.append((self.margin_m(formed[0]) + 2 * JUMP_TOLERANCE_M) / closing)
         return max(min(spans), MIN_SPAN_S)
 
+    def event_s(self) -> float:
+        """Predicted time (s) until the lowest formed rival lies :data:`JUMP_TOLERANCE_M` below
+        the followed point (the rival part of :meth:`span_s`; ``inf`` if none closes in). A
+        call ends there exactly rather than on a binary fraction of the driver's span (see
+        :meth:`.contact_stepping.ContactStepper.advance`)."""
+        formed = [r for r in self.rivals if r.formed]
+        if formed and formed[0].gap_rate_m_s < self.gap_rate_m_s:
+            closing = self.gap_rate_m_s - formed[0].gap_rate_m_s
+            return max((self.margin_m(formed[0]) + 2 * JUMP_TOLERANCE_M) / closing, MIN_SPAN_S)
+        return math.inf
+
 
 def relative_curvature(contact, q, s, kernels=None) -> float:
     """Relative curvature (1/m) of wheel and rail across the profile at surface parameters ``s``:

@@ -99,19 +99,22 @@ class ContactStepper:
         self._jumped_from = None  # (t, x, z, [(contact, new wheel parameter)]) of the last jump
         self.checks = check_contacts(form, x, z)
         self.span = min(min(c.span_s() for c in self.checks), self.switching.span_s(0.0, z, self.checks))
+        self.event = min(c.event_s() for c in self.checks)
 
     def set_dae(self, dae_fn) -> None:
         """Use ``dae_fn`` from now on (e.g. after a window moved)."""
         self.dae_fn = dae_fn
-        self._shifted = None
+        self._shifted = {}  # normalized -> shifted DAE
         self._integrators = {}
 
-    def call(self, x, z, t_a: float, h: float, inner=()):
+    def call(self, x, z, t_a: float, h: float, inner=(), free: bool = False):
         """States at ``t_a + inner`` and at ``t_a + h``: ``(x, z)``, one column per time (one
         IDAS call; ``RuntimeError`` on failure). ``inner``: offsets (s) in ``(0, h)`` of output
         times inside the call (IDAS interpolates them: they do not limit its steps). The
         integrator, cached per grid, solves the shifted DAE (:func:`shifted_dae`) from the
-        DAE's own ``x_dot``; see :meth:`_attempts` for the fallbacks."""
+        DAE's own ``x_dot``; ``free``: in time normalized by ``h`` (one integrator serves
+        every length: for calls off the binary grid); see :meth:`_attempts` for the
+        fallbacks."""
         p = np.r_[t_a, self.switching.open]
         grid = [float(v) for v in inner] + [h]
         x = np.asarray(x, float)
@@ -120,13 +123,15 @@ class ContactStepper:
         for n, (solver, shifted) in enumerate(self._attempts()):
             if n:
                 self.stats["contact_fallbacks"] += 1
-            integ = self._integrator(grid, solver, shifted)
+            normalized = free and shifted
+            integ = self._integrator([v / h for v in grid] if normalized else grid, solver, shifted, normalized)
             try:
                 if shifted:
                     if x_dot is None:
                         x_dot = np.asarray(self.dae_fn(0.0, x, z, p, ca.DM(0, 1))[0]).ravel()
                         scale = 1.0 + self.opts["reltol"] * np.abs(x) / self._atol(len(x))
-                    out = integ(x0=np.zeros(len(x)), z0=z, p=np.r_[p, x, x_dot, scale])
+                    p_ext = np.r_[p, x, x_dot, scale, h] if normalized else np.r_[p, x, x_dot, scale]
+                    out = integ(x0=np.zeros(len(x)), z0=z, p=p_ext)
                 else:
                     out = integ(x0=x, z0=z, p=p)
             except RuntimeError as err:
@@ -141,19 +146,20 @@ class ContactStepper:
             return xs, np.asarray(out["zf"])
         raise exc
 
-    def _integrator(self, grid, solver: str, shifted: bool):
+    def _integrator(self, grid, solver: str, shifted: bool, normalized: bool = False):
         """The integrator of the shifted DAE (or, not ``shifted``, of the DAE itself with
-        IDACalcIC) on ``grid`` with ``solver``, built on first use."""
-        key = (solver, shifted) + tuple(float(f"{v:.12e}") for v in grid)  # intervals differ in the last bits
+        IDACalcIC) on ``grid`` with ``solver``, built on first use; ``normalized``: the shifted
+        DAE in time normalized by the call's length (``grid`` in ``(0, 1]``)."""
+        key = (solver, shifted, normalized) + tuple(float(f"{v:.12e}") for v in grid)  # intervals differ in the last bits
         integ = self._integrators.get(key)
         if integ is None:
             if shifted:
-                if self._shifted is None:
-                    self._shifted = shifted_dae(self.dae_fn)
+                if normalized not in self._shifted:
+                    self._shifted[normalized] = shifted_dae(self.dae_fn, normalized)
                 # IDAS's first step would be a thousandth of the first output time (xi_dot = 0
                 # gives it no other scale): the call's length instead, so that the steps do not
                 # depend on the outputs inside the call.
-                dae, opts = self._shifted, {**self.opts, "calc_ic": False, "step0": INITIAL_STEP * grid[-1]}
+                dae, opts = self._shifted[normalized], {**self.opts, "calc_ic": False, "step0": INITIAL_STEP * grid[-1]}
             else:
                 dae, opts = self.dae_fn, self.opts
             if len(self._integrators) >= MAX_INTEGRATORS:
@@ -226,8 +232,32 @@ class ContactStepper:
                 self.stats["lift_offs" if s.kind == "lift-off" else "touchdowns"] += 1
             checks = check_contacts(self.form, x, z)
         self.span = min(min(c.span_s() for c in checks), self.switching.span_s(t, z, checks))
+        self.event = min(c.event_s() for c in checks)
         self.checks = checks
         return x, z, jumped + [s.name for s in switched]
+
+    def _next_end(self, pos, end: int, k_max: int, dt: float):
+        """``(end position, free)`` of the next call from ``pos`` (an integer, in units of
+        ``dt / end``, see :meth:`advance`). On the binary grid: ``dt / 2^k``, the longest not beyond the span,
+        from a multiple of it (one integrator per grid serves all such calls). A predicted jump
+        (:meth:`.contact_jumps.ContactCheck.event_s`) that binds the span is called to exactly
+        (a free call, :meth:`call`), where calls on the grid would close in on it by halves;
+        from off the grid (after such a call), a free call goes to the next multiple of the
+        level, or of the one above if that is within the span (no call shorter than a quarter
+        of it)."""
+        k = min(k_max, max(0, math.ceil(math.log2(dt / self.span)))) if self.span < dt else 0
+        unit = 2 ** (k_max - k)
+        if math.isfinite(self.event) and self.event <= self.span * (1 + 1e-9):
+            # On the finest grid (dt / end <= MIN_SPAN_S), so that positions stay integers.
+            event_end = max(pos + 1, round(pos + self.event / dt * end))
+            if event_end < end:
+                return event_end, True
+        if pos % unit == 0:
+            return pos + unit, False
+        b = (math.floor(pos / unit) + 1) * unit
+        if b - pos < 0.25 * unit and b + unit <= end and (b + unit - pos) * dt / end <= self.span:
+            b += unit
+        return b, True
 
     def advance(self, x, z, t0: float, times, emit=None):
         """State at ``times[-1]`` from ``(x, z)`` at ``t0``, with the contacts checked after
@@ -257,20 +287,19 @@ class ContactStepper:
         k_max = max(0, math.ceil(math.log2(dt / MIN_SPAN_S)))
         # The position in units of dt / 2^k_max and the length in levels k (dt / 2^k).
         pos, end = 0, 2**k_max
+        shortest = dt / end * (1 + 1e-9)
         failures = 0
         stall_t, stalled = t0, 0
         emitted = 0
         while pos < end:
-            k = min(k_max, max(0, math.ceil(math.log2(dt / self.span)))) if self.span < dt else 0
-            while pos % 2 ** (k_max - k):
-                k += 1  # aligned, so that the calls end exactly on t1
+            pos_b, free = self._next_end(pos, end, k_max, dt)
             t = t0 + dt * pos / end
-            h = dt / 2**k
-            t_b = t0 + dt * (pos + 2 ** (k_max - k)) / end
+            t_b = t0 + dt * pos_b / end
+            h = t_b - t
             # Output times strictly inside the call (those within rounding of its end are its end).
             inside = [j for j in range(emitted, len(times) - 1) if times[j] < t_b - 1e-12 * max(1.0, abs(t_b))]
             try:
-                xs_new, zs_new = self.call(x, z, t, h, [times[j] - t for j in inside])
+                xs_new, zs_new = self.call(x, z, t, h, [times[j] - t for j in inside], free)
             except RuntimeError as exc:
                 self.stats["contact_retries"] += 1
                 failures += 1
@@ -289,31 +318,31 @@ class ContactStepper:
                 x, z, jumped = self._after(x, z, t, relaxed=failures <= RELAXED_JUMPS)
                 if jumped:
                     continue
-                if k >= k_max:
+                if h <= shortest:
                     raise CallFailed(t, x, z, exc) from None
-                self.span = h / 4
+                self.span, self.event = h / 4, math.inf
                 continue
             except (SolverError, ParameterError) as exc:
                 raise CallFailed(t, x, z, exc) from None
             self.stats["contact_calls"] += 1
             failures = 0
-            if k < k_max:
+            if h > shortest:
                 offsets = [times[j] - t for j in inside] + [h]
                 t_switch = self.switching.overshoot(z, self.checks, offsets, xs_new, zs_new)
                 if t_switch is not None:
                     # A switch passed unpredicted: redo the call up to just before it.
                     self.stats["switch_redos"] += 1
-                    self.span = max(0.9 * t_switch, MIN_SPAN_S)
+                    self.span, self.event = max(0.9 * t_switch, MIN_SPAN_S), math.inf
                     continue
             checks_end = check_contacts(self.form, xs_new[:, -1], zs_new[:, -1])
-            if k < k_max:
+            if h > shortest:
                 t_late = self._late_jump(checks_end, h, t)
                 if t_late is not None:
                     # A rival sank below the followed point unpredicted: redo up to before it.
                     self.stats["jump_redos"] += 1
-                    self.span = max(0.9 * t_late, MIN_SPAN_S)
+                    self.span, self.event = max(0.9 * t_late, MIN_SPAN_S), math.inf
                     continue
-            pos += 2 ** (k_max - k)
+            pos = pos_b
             for col, j in enumerate(inside):
                 if emit is not None:
                     emit(j, xs_new[:, col], zs_new[:, col])
@@ -330,16 +359,23 @@ class ContactStepper:
         return x, z
 
 
-def shifted_dae(dae_fn: ca.Function) -> ca.Function:
+def shifted_dae(dae_fn: ca.Function, normalized: bool = False) -> ca.Function:
     """The DAE ``(t, x, z, p, u) -> (ode, alg, quad, zero)`` in the state's scaled departure from
     its linear extrapolation: ``x = x_a + t x_dot_a + D xi``, ``xi_dot = (ode - x_dot_a) / D``,
     with ``p`` extended by ``x_a``, ``x_dot_a`` and ``D``. ``xi = 0`` with ``xi_dot = 0`` is a
-    consistent start when ``x_dot_a`` is the DAE's own ``ode`` there (see the module docstring)."""
+    consistent start when ``x_dot_a`` is the DAE's own ``ode`` there (see the module docstring).
+    ``normalized``: in the time ``tau = t / h``, with ``p`` extended further by ``h`` (s), so
+    that one integrator on ``tau`` in ``[0, 1]`` serves calls of every length."""
     n_x, n_z, n_p = dae_fn.size1_in(1), dae_fn.size1_in(2), dae_fn.size1_in(3)
-    t, xi, z = ca.MX.sym("t"), ca.MX.sym("xi", n_x), ca.MX.sym("z", n_z)
-    p_ext, u = ca.MX.sym("p", n_p + 3 * n_x), ca.MX.sym("u", dae_fn.size1_in(4))
+    tau, xi, z = ca.MX.sym("t"), ca.MX.sym("xi", n_x), ca.MX.sym("z", n_z)
+    p_ext, u = ca.MX.sym("p", n_p + 3 * n_x + int(normalized)), ca.MX.sym("u", dae_fn.size1_in(4))
     p, x_a = p_ext[:n_p], p_ext[n_p : n_p + n_x]
-    x_dot_a, scale = p_ext[n_p + n_x : n_p + 2 * n_x], p_ext[n_p + 2 * n_x :]
+    x_dot_a, scale = p_ext[n_p + n_x : n_p + 2 * n_x], p_ext[n_p + 2 * n_x : n_p + 3 * n_x]
+    h = p_ext[-1] if normalized else None
+    t = tau if h is None else h * tau
     ode, alg, quad, zero = dae_fn(t, x_a + t * x_dot_a + scale * xi, z, p, u)
-    return ca.Function(f"{dae_fn.name()}_shifted", [t, xi, z, p_ext, u], [(ode - x_dot_a) / scale, alg, quad, zero],
+    xi_dot = (ode - x_dot_a) / scale
+    if h is not None:
+        xi_dot, quad = h * xi_dot, h * quad
+    return ca.Function(f"{dae_fn.name()}_shifted", [tau, xi, z, p_ext, u], [xi_dot, alg, quad, zero],
                        dae_fn.name_in(), dae_fn.name_out())

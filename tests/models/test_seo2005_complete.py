@@ -19,6 +19,10 @@ def test_complete_scene_starts_in_equilibrium_and_the_wheels_carry_everything():
     # The pan-head starts where the catenary-only model's equilibrium puts it.
     cat = load_model("seo2005_catenary")
     static = cat.run(cat.resolve({"t_end": 0.0})).summary
+    # The summary is the catenary-only model's plus the wheels'.
+    moving = cat.run(cat.resolve({"t_end": 0.01, "n_out": 100})).summary
+    assert set(moving) <= set(s), sorted(set(moving) - set(s))
+    assert {"wheel_normal_force_static_N", "wheel_normal_force_min_N", "wheel_normal_force_max_N"} <= set(s)
     np.testing.assert_allclose(s["static_contact_force_N"], static["static_contact_force_N"], rtol=1e-8)
     # (at 17 m/s the sliding point follows the sagging wire: m v^2 kappa ~ 0.1 N more than at rest)
     np.testing.assert_allclose(-res.reactions_N["contact"][0, 2], static["static_contact_force_N"], rtol=3e-3)

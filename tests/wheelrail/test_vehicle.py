@@ -81,3 +81,27 @@ def test_bad_vehicle_input_names_the_item():
         VehicleParameters(frame_mass_kg=-3.0)
     with pytest.raises(ParameterError, match="lateral_offset_m"):
         load_model("vehicle").resolve({"lateral_offset_m": 0.02})
+
+
+def test_vehicle_model_runs_and_summarizes(tmp_path):
+    """``symcat run vehicle`` end to end: the summary's wheel forces, lateral displacements and
+    derailment quotients, its weight balance, and the files it writes."""
+    from symcat.model import run_model
+
+    r = run_model("vehicle", {"profile": "s1002_uic60", "t_end": 0.2, "n_out": 20, "lateral_offset_m": 0.002},
+                  out=tmp_path)
+    s = r.summary
+    for key in ("wheel_names", "normal_force_static_N", "normal_force_min_N", "normal_force_max_N",
+                "lateral_displacement_max_m", "derailment_quotient_max", "wall_s"):
+        assert key in s, key
+    assert len(s["wheel_names"]) == len(s["normal_force_static_N"]) == len(s["derailment_quotient_max"]) == 8
+    assert len(s["lateral_displacement_max_m"]) == 4
+    # (to 1e-6 when centred, tested above; the offset wheelsets sit higher and rolled on S1002,
+    # so the preloaded suspensions start 120 N off the weight)
+    assert s["vertical_force_static_sum_N"] == pytest.approx(s["weight_N"], rel=1e-3)
+    # The wheelsets start 2 mm off centre and oscillate within it on tangent track.
+    assert 0.0015 < max(s["lateral_displacement_max_m"]) < 0.0025
+    assert 0.0 < max(s["derailment_quotient_max"]) < 0.2
+    assert min(s["normal_force_min_N"]) > 0.7 * min(s["normal_force_static_N"])
+    assert s["wall_s"] > 0
+    assert {"vehicle.png", "vehicle.npz", "summary.json"} <= {p.name for p in tmp_path.iterdir()}
