@@ -15,8 +15,13 @@ IDAS's error weights those of ``x`` (its relative part measured on ``xi`` alone 
 the test on large coordinates). This spares both a fresh integrator per call (10 ms for a
 compiled DAE, 50 ms over the graph) and IDACalcIC (30 % of the wall time of an S1002 vehicle),
 which remains the last resort (:meth:`ContactStepper._attempts`).
-(An integrator in normalized time ``tau = (t - t_a) / h`` would serve every length, but IDAS
-then takes a hundred times longer to give up at a fold.)
+
+Two kinds of call leave the binary grid (*free* calls, in the normalized time
+``tau = (t - t_a) / h``, where one integrator serves every length): a call that ends exactly at
+a predicted contact jump (on the grid, the calls would close in on it by halves: six to eight
+calls and checks per jump), and, from such an end, one call back to the grid at the level the
+span allows (on the grid, the calls would double from the finest level up). On an S1002
+vehicle this halves the calls (170 -> 93 per simulated second).
 """
 from __future__ import annotations
 
