@@ -1,10 +1,11 @@
 """Wheelset on straight track (constraint wheel/rail contact): work-precision and wall time per
-simulated second. ``python -m bench.wheelset`` prints the section; ``make bench`` adds it to the
-report."""
+simulated second. ``python -m bench.wheelset`` prints the section and writes it to
+``bench/report/wheelset.md``; ``make bench`` adds it to the report."""
 from __future__ import annotations
 
 import statistics
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -77,5 +78,7 @@ def section(report_dir=None) -> list[str]:
 
 
 if __name__ == "__main__":
-    print("\n".join(section()))
+    lines = section()
+    (Path(__file__).resolve().parent / "report" / "wheelset.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
     sys.exit(0)

@@ -160,7 +160,7 @@ def run(p: dict) -> ModelOutput:
         raise SolverError(f"{err} (vehicle model: try index=ggl or a tighter rtol{hint}; a flange contact or a contact "
                           "jump may have been reached)") from err
     summary = summarize(res, layout)
-    stats = {k: res.stats[k] for k in ("nsteps", "nfevals", "netfails", "nncfails", "restarts")}
+    stats = {k: res.stats[k] for k in ("nsteps", "nfevals", "netfails", "nncfails", "restarts", "contact_calls")}
 
     def write(out):
         import matplotlib
@@ -192,7 +192,7 @@ def run(p: dict) -> ModelOutput:
         plt.close(fig)
         return [path, out / "vehicle.npz"]
 
-    return ModelOutput(summary, stats, {"result": res}, write)
+    return ModelOutput(summary, stats, {"result": res, "layout": layout}, write)
 
 
 MODEL = Model("vehicle", "the seed paper's railroad vehicle (car body, two bogies with frames, bolsters, equalizer "
