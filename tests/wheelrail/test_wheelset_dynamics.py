@@ -188,6 +188,30 @@ def test_s1002_contact_point_jumps_and_the_run_continues():
     assert res.position_drift.max() < 5e-5
 
 
+def test_s1002_flange_to_tread_and_over_to_the_other_flange():
+    """Released 8 mm toward the right with linear creep, an S1002 wheelset starts on its right
+    flange flank (contact angle above 50 degrees), whose lateral force pushes it across: the
+    right contact comes down the flank onto the tread (below 2 degrees, through jumps over the
+    flange root), and 0.3 s later the left wheel climbs its flange. The run completes with
+    both wheels loaded throughout."""
+    from symcat.wheelrail import profile_pair
+
+    wheel = profile_pair("s1002_uic60", 0.05).wheel
+    res = run_model("wheelset", {"profile": "s1002_uic60", "lateral_offset_m": -0.008, "creep": "linear",
+                                 "t_end": 0.3, "n_out": 60}).arrays["result"]
+    angle = {n: np.degrees(np.arctan(np.abs(wheel.slope(np.asarray(w["s"])[:, 0]))))
+             for n, w in res.wheelrail.items()}
+    right, left = angle["right_wheel"], angle["left_wheel"]
+    assert right[0] > 50 and left[0] < 2
+    assert right.min() < 2 and left.max() > 50
+    assert np.argmin(right) < np.argmax(left)  # off one flange before onto the other
+    assert res.stats["contact_jumps"] >= 2
+    y = res.coordinate("wheelset.y")
+    assert y[0] == pytest.approx(-0.008) and y.max() > 0.005
+    for w in res.wheelrail.values():
+        assert np.all(np.isfinite(w["normal_force_N"])) and w["normal_force_N"].min() > 10e3
+
+
 def test_wheelset_model_summary_keys_and_outputs(tmp_path):
     r = run_model("wheelset", {"speed_ms": 10.0, "t_end": 4.0, "n_out": 200}, out=tmp_path)
     s = r.summary
