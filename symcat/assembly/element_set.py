@@ -31,11 +31,17 @@ class ElementSet:
         self.params = np.asarray(params, dtype=float)
         self.n = len(self.indices)
         self.n_global = n_global
-        self.lib = kernel_library(element.name)
         self._gather_index = self.indices.ravel().tolist()
         self._p = ca.DM(self.params.T)  # n_params x N
         self._vec_scatter = vector_scatter(self.indices, n_global)
         self._mat_scatter = None
+
+    @property
+    def lib(self):
+        """The element's kernel library, looked up at each use: inside
+        :func:`symcat.codegen.library.symbolic_kernels` it is the SX form, so that a whole model
+        DAE over these elements expands and compiles (:mod:`symcat.codegen.model_dae`)."""
+        return kernel_library(self.element.name)
 
     def _map(self, name: str):
         return self.lib[name].map(self.n)

@@ -7,7 +7,7 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sps
 
-from ..codegen.library import kernel_library
+from ..codegen.library import in_symbolic_kernels, kernel_library
 from ..scene.loads import NodalForce, SlopeMoment
 from ..scene.scene import Scene
 from .dofs import DofMap
@@ -101,7 +101,8 @@ class System:
         Jacobian supplied explicitly (``custom_jacobian``) from the compiled element stiffness
         and damping kernels scattered into sparse matrices, instead of CasADi's AD through the
         mapped kernels (about ten times faster on long wires)."""
-        if getattr(self, "_force_fn", None) is not None:
+        symbolic = in_symbolic_kernels()  # the cached function calls the compiled kernels
+        if getattr(self, "_force_fn", None) is not None and not symbolic:
             return self._force_fn
         q, v = ca.MX.sym("q", self.n), ca.MX.sym("v", self.n)
         f = self.internal_force(q, v) + self.external_force(q)
@@ -116,9 +117,10 @@ class System:
             d_q += ca.jacobian(self._moment_force(q), q)
         out = ca.MX.sym("out_f", self.n)
         jac = ca.Function("jac_ancf_forces", [q, v, out], [d_q, d_v], ["q", "v", "out_f"], ["jac_f_q", "jac_f_v"])
-        self._force_fn = ca.Function("ancf_forces", [q, v], [f], ["q", "v"], ["f"],
-                                     {"custom_jacobian": jac, "jac_penalty": 0})
-        return self._force_fn
+        fn = ca.Function("ancf_forces", [q, v], [f], ["q", "v"], ["f"], {"custom_jacobian": jac, "jac_penalty": 0})
+        if not symbolic:
+            self._force_fn = fn
+        return fn
 
     # --- compiled numeric functions -------------------------------------------------------
     @cached_property

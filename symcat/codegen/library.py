@@ -199,6 +199,12 @@ def symbolic_kernels():
         _SYMBOLIC_DEPTH[0] -= 1
 
 
+def in_symbolic_kernels() -> bool:
+    """Whether :func:`kernel_library` gives SX forms now (inside :func:`symbolic_kernels`):
+    functions cached over compiled kernels must then be built afresh."""
+    return bool(_SYMBOLIC_DEPTH[0])
+
+
 def kernel_library(name: str) -> KernelLibrary:
     """Load (compiling on first use) the kernel library ``name``; inside
     :func:`symbolic_kernels`, its SX form."""

@@ -55,6 +55,10 @@ def compiled_dae(build: Callable[[], ca.Function]) -> ca.Function:
         t0 = time.perf_counter()
         with symbolic_kernels():
             sx = build().expand()
+        if any(sx.instruction_id(k) == ca.OP_CALL for k in range(sx.n_instructions())):
+            # A kernel captured as an external before `build` ran: the C code would call a
+            # symbol no library defines.
+            raise RuntimeError(f"the DAE {name!r} calls compiled kernels that do not expand to SX")
         log.info("compiling the model's DAE (%d operations and their Jacobian)", sx.n_instructions())
         jac = sx.jacobian()
         with tempfile.TemporaryDirectory() as tmp:

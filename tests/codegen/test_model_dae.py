@@ -72,3 +72,27 @@ def test_compiled_once_and_same_simulation():
     # coordinates of order 0.5 m; a wrong residual would move the wheelset by millimetres).
     for name in ("wheelset.y", "wheelset.z"):
         assert np.abs(graph.coordinate(name) - compiled.coordinate(name)).max() < 1e-7
+
+
+def test_ancf_model_compiles_whole_after_its_graph_was_built(rng):
+    """A wire (ANCF elements, their forces a cached function over the compiled kernels) with a
+    body on a sliding joint: the compiled DAE, built after the graph (so after that cache was
+    filled), contains the elements' SX and calls no kernel library (it used to call the cached
+    externals: a library with undefined symbols), and equals the graph."""
+    from symcat.model import load_model
+
+    slider = load_model("slider_on_wire")
+    model = MultibodyModel(slider.run.__globals__["build"](slider.resolve({"n_elements": 4})))
+    form = Formulation(model, "augmented", "ggl", 10.0, False)
+    x, z = consistent_state(form, 0.0)
+    graph = form.dae_function()
+    graph(0.0, x, z, np.zeros(graph.size1_in(3)), ca.DM(0, 1))  # the cached force function exists
+    compiled = compiled_dae(form.dae_function)
+    assert compiled.class_name() == "External"
+    p = np.zeros(graph.size1_in(3))
+    for k in range(3):
+        xs = x + (1e-4 * rng.standard_normal(len(x)) if k else 0.0)
+        zs = z * (1 + 1e-3 * rng.standard_normal(len(z)))
+        for a, b in list(zip(graph(0.01, xs, zs, p, ca.DM(0, 1)), compiled(0.01, xs, zs, p, ca.DM(0, 1))))[:2]:
+            a, b = np.asarray(a).ravel(), np.asarray(b).ravel()
+            assert np.allclose(a, b, rtol=1e-10, atol=1e-9 * (1 + np.abs(a).max()))
