@@ -114,7 +114,8 @@ def run(p: dict) -> ModelOutput:
         res = simulate(model, p["t_end"], "augmented", "ggl", rtol=p["rtol"], atol=cat._atol(model, p["rtol"] * 1e-2),
                        n_out=n_out, progress=p.get("progress", True))
     except SolverError as err:
-        raise SolverError(f"{err} (seo2005: vehicle, pantograph and catenary; try a tighter rtol)") from err
+        raise SolverError(f"{err} (seo2005: vehicle, pantograph and catenary; try a tighter rtol)",
+                          partial=err.partial) from err
     z = res.q[:, off + 2] - WIRE_HEIGHT_M
     acc = res.a[:, off + 2]
     force, lost, s_hist = cat.contact_history(res, p["contact"])

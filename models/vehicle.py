@@ -158,7 +158,7 @@ def run(p: dict) -> ModelOutput:
     except SolverError as err:
         hint = "; in a canted curve index=1 (the cant ramps' ends are impacts)" if p.get("cant_m", 0.0) > 0 else ""
         raise SolverError(f"{err} (vehicle model: try index=ggl or a tighter rtol{hint}; a flange contact or a contact "
-                          "jump may have been reached)") from err
+                          "jump may have been reached)", partial=err.partial) from err
     summary = summarize(res, layout)
     stats = {k: res.stats[k] for k in ("nsteps", "nfevals", "netfails", "nncfails", "restarts", "contact_calls")}
 

@@ -121,7 +121,8 @@ def run(p: dict) -> ModelOutput:
                        progress=p.get("progress", True))
     except SolverError as err:
         raise SolverError(f"{err} (wheelset model: one constraint contact point per wheel, which jumps to the "
-                          "lowest point of the gap; a free wheelset hunts, and at speed its flanges strike)") from err
+                          "lowest point of the gap; a free wheelset hunts, and at speed its flanges strike)",
+                          partial=err.partial) from err
     x, y = res.coordinate("wheelset.x"), res.coordinate("wheelset.y")
     left, right = res.wheelrail["left_wheel"], res.wheelrail["right_wheel"]
     radius = {k: placed.contacts[k].rolling_radius_m for k in ("left", "right")}

@@ -51,6 +51,9 @@ REFUSAL_HOLD_S = 1e-3
 #: A run stalls when this many calls fail within :data:`STALL_SPAN_S` of simulated time.
 STALL_FAILURES = 60
 STALL_SPAN_S = 1e-4
+#: A failure while a contact point moves faster than this along its wheel profile (m/s) is
+#: reported with it (:meth:`ContactStepper._sweep_hint`).
+SWEEP_HINT_M_S = 5.0
 
 
 class CallFailed(RuntimeError):
@@ -197,6 +200,19 @@ class ContactStepper:
                 "conformal wheel and rail, where one constraint point per wheel is ill-conditioned (another "
                 "n_out or rtol moves the call boundaries; profiles with more curvature difference avoid it)")
 
+    def _sweep_hint(self) -> str:
+        """Why the contact points may defeat IDAS, if one sweeps: the fastest along its wheel
+        profile when that exceeds :data:`SWEEP_HINT_M_S` (its rate grows as the relative
+        curvature shrinks: nearly conformal profiles, e.g. the flange root of S1002 on the
+        gauge corner of UIC60, crossed without creep damping)."""
+        fast = max(self.checks, key=lambda c: abs(c.s_rate[0]))
+        rate = abs(float(fast.s_rate[0]))
+        if rate < SWEEP_HINT_M_S:
+            return ""
+        return (f" (the {fast.name} contact point was sweeping along its wheel at {rate:.3g} m/s, relative curvature "
+                f"{fast.curvature_per_m:.3g} 1/m: nearly conformal wheel and rail, which one constraint point per "
+                "wheel follows only as fast as IDAS converges; creep forces damp such sweeps)")
+
     def _late_jump(self, checks_end, h: float, t: float) -> float | None:
         """Time (s after the call's start) at which a rival sank below the followed point, if at
         the call's end one lies deeper than :data:`LATE_JUMP_GAP_M` (linear interpolation of
@@ -324,7 +340,7 @@ class ContactStepper:
                 if jumped:
                     continue
                 if h <= shortest:
-                    raise CallFailed(t, x, z, exc) from None
+                    raise CallFailed(t, x, z, RuntimeError(f"{exc}{self._sweep_hint()}")) from None
                 self.span, self.event = h / 4, math.inf
                 continue
             except (SolverError, ParameterError) as exc:
