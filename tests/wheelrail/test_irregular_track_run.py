@@ -1,5 +1,6 @@
-"""A wheelset running over measured track irregularities (``irregularity_file`` of the wheelset
-model, :func:`symcat.wheelrail.track.read_irregularities`) against the kinematic equations."""
+"""Measured track irregularities in simulations (``irregularity_file`` of the wheelset and
+vehicle models, :func:`symcat.wheelrail.track.read_irregularities`): a wheelset over an
+alignment bump against the kinematic equations, the vehicle on a layout, bad files."""
 from __future__ import annotations
 
 import math
@@ -86,3 +87,31 @@ def test_bad_irregularity_file_names_the_parameter(tmp_path, content, match):
         path.write_text(content)
     with pytest.raises(ParameterError, match=match):
         run_model("wheelset", {"irregularity_file": str(path), "t_end": 0.1})
+
+
+def test_vehicle_model_on_a_layout_without_irregularities_runs_as_on_ideal_track(tmp_path):
+    """``irregularity_file`` of the vehicle model puts the vehicle on a tangent layout: with an
+    all-zero file it runs as on the ideal track (wheelsets' positions to 1e-14 m, normal forces
+    to 1.2e-6 N of 57 kN measured over 0.05 s)."""
+    path = tmp_path / "zero.csv"
+    np.savetxt(path, np.c_[np.arange(0.0, 30.0, 0.5), np.zeros(60)], delimiter=",", header="s_m,level_m", comments="")
+    kw = {"profile": "conical", "t_end": 0.05, "n_out": 10, "lateral_offset_m": 0.002}
+    on_layout = run_model("vehicle", {**kw, "irregularity_file": str(path)})
+    ideal = run_model("vehicle", kw)
+    assert on_layout.arrays["layout"].track is not None and ideal.arrays["layout"].track is None
+    for key in ("normal_force_min_N", "normal_force_max_N"):
+        np.testing.assert_allclose(on_layout.summary[key], ideal.summary[key], rtol=1e-9)
+    a, b = on_layout.arrays["result"], ideal.arrays["result"]
+    for w in on_layout.arrays["layout"].wheelsets:
+        np.testing.assert_allclose(a.coordinate(f"{w}.y"), b.coordinate(f"{w}.y"), rtol=0, atol=1e-12)
+
+
+def test_vehicle_model_names_a_bad_irregularity_file(tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("s_m,alignment_m\n0,0\n1,0\n")
+    with pytest.raises(ParameterError, match=r"irregularity_file=.*at least 4"):
+        run_model("vehicle", {"irregularity_file": str(bad), "t_end": 0.01})
+    with pytest.raises(ParameterError, match=r"irregularity_file=.*cannot be read"):
+        run_model("vehicle", {"irregularity_file": str(tmp_path / "none.csv"), "t_end": 0.01})
+    with pytest.raises(ParameterError, match=r"irregularities need tangent track"):
+        run_model("vehicle", {"irregularity_file": str(bad), "curve_radius_m": 800.0, "t_end": 0.01})
