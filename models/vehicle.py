@@ -1,6 +1,12 @@
 """The seed paper's railroad vehicle (Figures 8 and 9) on tangent track or into a curve, with
 constraint wheel/rail contact.
 
+Measured irregularities on tangent track: ``irregularity_file`` names a CSV file with a header
+row, ``s_m`` (distance along the track from the vehicle centre's start, m) and any of
+``alignment_m``, ``level_m``, ``cross_level_m``, ``gauge_m`` (m;
+:func:`symcat.wheelrail.track.read_irregularities`); the track is then a tangent
+:class:`symcat.wheelrail.track.TrackLayout` carrying them (slower: its DAE is not compiled).
+
 A car body on two bogies; each bogie has a frame, a bolster, two equalizer bars and two
 wheelsets (:mod:`symcat.vehicle`: Manchester benchmark vehicle 1 with documented, assumed values
 for the bolsters and equalizer bars), eight wheel/rail contacts by the constraint formulation
@@ -56,6 +62,7 @@ from symcat.scene import Scene
 from symcat.vehicle import (DRIVES, VehicleParameters, add_vehicle, curve_track, lateral_displacement_m,
                             lateral_force_sum_N, steady_curving_forces_N, wheel_forces)
 from symcat.wheelrail import PAIR_NAMES, profile_pair
+from symcat.wheelrail.track import Tangent, TrackLayout, rail_offset_for, read_irregularities
 
 G = 9.81
 
@@ -85,7 +92,13 @@ PARAMETERS = [
     Parameter("atol", 0.0, "m", "IDAS absolute tolerance of positions (m, rad) and velocities (m/s, rad/s); 0: rtol/10",
               minimum=0.0, maximum=0.1),
     Parameter("n_out", 100, "-", "output intervals", minimum=10, maximum=100000),
+    Parameter("irregularity_file", "", "", "CSV of measured track irregularities on tangent track: header s_m (from "
+              "the vehicle centre's start, m) and any of alignment_m, level_m, cross_level_m, gauge_m (m); empty: "
+              "ideal track"),
 ]
+
+#: Track beyond the outermost wheelsets on a tangent layout with irregularities (m).
+TRACK_MARGIN_M = 5.0
 
 
 def track_for(p: dict, pair, parameters: VehicleParameters):
@@ -94,10 +107,30 @@ def track_for(p: dict, pair, parameters: VehicleParameters):
     if p.get("curve_radius_m", 0.0) <= 0:
         if p.get("cant_m", 0.0) > 0:
             raise ParameterError(f"cant_m={p['cant_m']:g}: a cant needs a curve (curve_radius_m > 0)")
-        return None, 0.0
+        return irregular_track(p, pair, parameters)
+    if p.get("irregularity_file"):
+        raise ParameterError(f"irregularity_file={p['irregularity_file']!r}: irregularities need tangent track "
+                             "(curve_radius_m = 0)")
     return curve_track(pair, p["curve_radius_m"], cant_m=p["cant_m"], transition_length_m=p["transition_length_m"],
                        curve_length_m=p["speed_ms"] * p["t_end"] + 10.0, direction=p["curve_direction"],
                        parameters=parameters)
+
+
+def irregular_track(p: dict, pair, parameters: VehicleParameters):
+    """``(track, x_m)``: tangent track along global ``x`` carrying the irregularities of
+    ``p["irregularity_file"]`` and the chainage of the vehicle centre's start (global ``x = 0``,
+    the file's ``s_m = 0``), or ``(None, 0.0)`` without a file."""
+    path = p.get("irregularity_file", "")
+    if not path:
+        return None, 0.0
+    lead = parameters.bogie_semi_distance_m + parameters.semi_wheelbase_m + TRACK_MARGIN_M
+    try:
+        irregularities = read_irregularities(path, start_m=lead)
+    except ParameterError as err:
+        raise ParameterError(f"irregularity_file={path!r}: {err}") from None
+    track = TrackLayout([Tangent(2 * lead + p["speed_ms"] * p["t_end"])], rail_offset_m=rail_offset_for(pair.rail),
+                        irregularities=irregularities, start_position_m=(-lead, 0.0, 0.0))
+    return track, lead
 
 
 def build(p: dict):
@@ -106,7 +139,8 @@ def build(p: dict):
     pair = profile_pair(p["profile"], p["conicity"])
     parameters = VehicleParameters()
     track, x_m = track_for(p, pair, parameters)
-    drive = p["drive"] if p["drive"] != "auto" else ("constraint" if track is None else "torque")
+    curved = p.get("curve_radius_m", 0.0) > 0
+    drive = p["drive"] if p["drive"] != "auto" else ("torque" if curved else "constraint")
     layout = add_vehicle(scene, pair, speed_ms=p["speed_ms"], creep={"nonlinear": "polach"}.get(p["creep"], p["creep"]),
                          friction_coefficient=p["friction_coefficient"], drive=drive,
                          lateral_offset_m=p["lateral_offset_m"], parameters=parameters, track=track, x_m=x_m)
@@ -174,7 +208,7 @@ def run(p: dict) -> ModelOutput:
         for w, y in lateral_displacement_m(res, layout).items():
             axes[0].plot(res.t_s, y * 1e3, lw=1, label=w)
         axes[0].set_ylabel("wheelset lateral [mm]")
-        where = f", curve R {p['curve_radius_m']:g} m, cant {p['cant_m'] * 1e3:g} mm" if layout.track else ""
+        where = f", curve R {p['curve_radius_m']:g} m, cant {p['cant_m'] * 1e3:g} mm" if p["curve_radius_m"] > 0 else ""
         axes[0].set_title(f"vehicle, {p['profile']}, {p['speed_ms']:g} m/s, creep {p['creep']}{where}", fontsize=9)
         for n in layout.contact_names:
             axes[1].plot(res.t_s, forces[n]["normal_N"] / 1e3, lw=1, label=n)

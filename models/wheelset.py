@@ -12,6 +12,15 @@ with the Hertz ellipse of the static load, or absent (``none``: frictionless whe
 gravitational stiffness of the contact angles acts). The run starts from the wheelset resting
 at ``lateral_offset_m`` toward the left rail, rolling without slip.
 
+Measured track irregularities: ``irregularity_file`` names a CSV file with a header row,
+``s_m`` (distance along the track from the wheelset's start, m, at least 4 strictly increasing
+values) and any of ``alignment_m`` (lateral, toward the left rail), ``level_m`` (up),
+``cross_level_m`` (left rail over right), ``gauge_m`` (widening), all in m
+(:func:`symcat.wheelrail.track.read_irregularities`; zero outside the file's range: taper the
+data to zero at its ends). The track is then a tangent :class:`symcat.wheelrail.track.TrackLayout`
+carrying them (the same straight track along global ``x``, evaluated through the layout's rail
+frames: slower, the DAE is not compiled). Empty (default): ideal track.
+
 Summary
 -------
 ``lateral_wavelength_m``
@@ -42,6 +51,7 @@ from symcat.integrate import simulate
 from symcat.model import Model, ModelOutput, Parameter
 from symcat.scene import CreepModel, Driving, PointLoad, RigidBody, Scene, WheelRailJoint
 from symcat.wheelrail import PAIR_NAMES, WheelsetDimensions, profile_pair, wheelset_on_track
+from symcat.wheelrail.track import Tangent, TrackLayout, rail_offset_for, read_irregularities
 
 G = 9.81
 MASS_KG = 1813.0
@@ -65,15 +75,25 @@ PARAMETERS = [
               choices=("augmented", "embedded")),
     Parameter("rtol", 1e-6, "-", "IDAS relative tolerance", minimum=0.0, maximum=0.1, exclusive_minimum=True),
     Parameter("n_out", 400, "-", "output intervals", minimum=10, maximum=100000),
+    Parameter("irregularity_file", "", "", "CSV of measured track irregularities: header s_m (from the start, m) and "
+              "any of alignment_m, level_m, cross_level_m, gauge_m (m); empty: ideal track"),
 ]
+
+#: Track behind the wheelset's start on a layout with irregularities (m): its contact points
+#: sit a little behind the axle when it yaws.
+LEAD_M = 2.0
+#: Track beyond the distance run (m).
+TAIL_M = 10.0
 
 
 def build(p: dict):
     """Scene, assembled model and the static placement of the wheelset for parameters ``p``."""
     pair = profile_pair(p["profile"], p["conicity"])
     dims = WheelsetDimensions(tape_circle_distance_m=1.5, nominal_radius_m=0.46)
+    track = irregular_track(p, pair)
     try:
-        placed = wheelset_on_track(pair.wheel, pair.rail, p["lateral_offset_m"], wheelset=dims)
+        placed = wheelset_on_track(pair.wheel, pair.rail, p["lateral_offset_m"], wheelset=dims, x_m=LEAD_M if track
+                                   else 0.0, track=track)
     except ParameterError as err:
         raise ParameterError(f"lateral_offset_m={p['lateral_offset_m']:g}: {err}") from None
     v = p["speed_ms"]
@@ -91,9 +111,25 @@ def build(p: dict):
                            nominal_normal_force_N=0.5 * (MASS_KG * G + p["axle_load_N"]),
                            friction_coefficient=p["friction_coefficient"])
     for side in ("left", "right"):
-        scene.add(WheelRailJoint(f"{side}_wheel", "wheelset", side, pair.wheel, pair.rail, wheelset=dims, creep=creep))
+        scene.add(WheelRailJoint(f"{side}_wheel", "wheelset", side, pair.wheel, pair.rail, wheelset=dims, creep=creep,
+                                 track=track))
     scene.add(Driving("forward_speed", "wheelset", direction=(1.0, 0.0, 0.0), velocity=v))
     return scene, MultibodyModel(scene), placed, pair
+
+
+def irregular_track(p: dict, pair):
+    """Tangent track along global ``x`` carrying the irregularities of ``p["irregularity_file"]``
+    (``s_m = 0`` at the wheelset's start, ``x = 0``), or None without a file."""
+    path = p.get("irregularity_file", "")
+    if not path:
+        return None
+    try:
+        irregularities = read_irregularities(path, start_m=LEAD_M)
+    except ParameterError as err:
+        raise ParameterError(f"irregularity_file={path!r}: {err}") from None
+    length = LEAD_M + p["speed_ms"] * p["t_end"] + TAIL_M
+    return TrackLayout([Tangent(length)], rail_offset_m=rail_offset_for(pair.rail), irregularities=irregularities,
+                       start_position_m=(-LEAD_M, 0.0, 0.0))
 
 
 def wavelength(x: np.ndarray, y: np.ndarray) -> float:

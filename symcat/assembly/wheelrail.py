@@ -8,10 +8,13 @@ made of comparisons, whose derivative is zero, so ``C``, ``C_q``, ``C_s`` and ``
 surface parameters across piece ends (C2 splines: the values are continuous there).
 
 Creep forces (:class:`symcat.scene.CreepModel`) are applied forces at the wheel's material point
-at the contact; they depend on the normal force, which is the multiplier of the gap row
-(``N = -lambda``: the constraint force on the wheelset is ``-C_q^T lambda`` and the gap row's
-gradient is the rail's outward normal), so :mod:`symcat.dae.formulation` adds them to the
-dynamics with the multipliers. The contact frame is ``t1`` the unit rail tangent along the track
+at the contact; they depend on the normal force, a linear function of the multipliers
+(:func:`normal_directions`), so :mod:`symcat.dae.formulation` adds them to the dynamics with
+the multipliers. The constraint force on the wheelset is ``-C_q^T lambda``. In the rail-frame
+form (eq. 22) the gap row's gradient is the rail's outward normal ``n``, so ``N = -lambda_gap``.
+In the global form (eq. 21) the three coincidence rows ``r^w - r^r`` have the identity as
+gradient in the wheelset position, so their force on the wheel is ``-lambda[0:3]``, normal to
+the rail surface where ``C_s^T lambda = 0`` holds; ``N = -n . lambda[0:3]``. The contact frame is ``t1`` the unit rail tangent along the track
 at the contact (rolling direction: global ``x`` on tangent track), ``n`` the rail's outward
 normal there, ``t2 = n x t1``; the creepages are the material point's velocity along ``t1, t2``
 and the wheelset's angular velocity along ``n``, divided by ``V = sqrt((R_dot . t1)^2 +
@@ -72,6 +75,7 @@ class WheelRailEntry:
     wheel_piece: ca.Function
     rail_piece: ca.Function
     track_piece: ca.Function | None = None  # curved track: s1r -> track piece (22)
+    normal_fn: ca.Function | None = None    # (s, p) -> the rail's unit outward normal (global)
     creep: CreepSetup | None = None
     creep_fn: ca.Function | None = None
     s_index: int = 0                # first of the contact's 4 entries in s
@@ -117,6 +121,7 @@ def add_wheelrail(model, joint: WheelRailJoint) -> WheelRailEntry:
                            piece_lookup(joint.rail, f"{joint.name}_rail_piece"))
     if contact.curved:
         entry.track_piece = contact.frames.lookup(f"{joint.name}_track_piece")
+    entry.normal_fn = rail_normal_function(f"{joint.name}_normal", curved=contact.curved)
     if joint.creep is not None:
         entry.creep = creep_setup(joint, contact, point)
         entry.creep_fn = creep_function(joint, entry.creep, curved=contact.curved)
@@ -183,6 +188,24 @@ def _rail_tangents(p, s, curved: bool):
     return t1r, ca.mtimes(a_t, ca.mtimes(rx, du))
 
 
+def _contact_frame(p, s, curved: bool):
+    """Unit contact frame ``(t1, t2, n)`` (global, SX): ``t1`` the rail tangent along the track,
+    ``n`` the rail's outward normal, ``t2 = n x t1`` (the kernels' ``n^r``)."""
+    side = p[0]
+    t1r, t2r = _rail_tangents(p, s, curved)
+    t1 = t1r if not curved else t1r / ca.norm_2(t1r)
+    n = side * ca.cross(t1, t2r)
+    n = n / ca.norm_2(n)
+    return t1, ca.cross(n, t1), n
+
+
+def rail_normal_function(name: str, curved: bool = False) -> ca.Function:
+    """SX function ``(s, p) -> n``: the rail's unit outward normal at surface parameters ``s``
+    (4) for kernel parameters ``p`` (24; 46 on curved track)."""
+    s, p = ca.SX.sym("s", 4), ca.SX.sym("p", 46 if curved else 24)
+    return ca.Function(name, [s, p], [_contact_frame(p, s, curved)[2]], ["s", "p"], ["n"])
+
+
 def creep_function(joint: WheelRailJoint, setup: CreepSetup, curved: bool = False) -> ca.Function:
     """SX function ``(x, x_dot, s, p, N) -> (Q, [xi_x, xi_y, phi, Fx, Fy, Mz])``: generalized creep
     forces on the wheelset coordinates ``x = [R, theta]`` (7) for surface parameters ``s``,
@@ -200,11 +223,7 @@ def creep_function(joint: WheelRailJoint, setup: CreepSetup, curved: bool = Fals
     g = ca.vertcat(ca.horzcat(-e1, e0, -e3, e2), ca.horzcat(-e2, e3, e0, -e1), ca.horzcat(-e3, -e2, e1, e0))
     omega = 2 * ca.mtimes(g, th_dot)
     v_point = r_dot + ca.cross(omega, arm)
-    t1r, t2r = _rail_tangents(p, s, curved)
-    t1 = t1r if not curved else t1r / ca.norm_2(t1r)
-    n = side * ca.cross(t1, t2r)
-    n = n / ca.norm_2(n)
-    t2 = ca.cross(n, t1)
+    t1, t2, n = _contact_frame(p, s, curved)
     cm = joint.creep
     speed = ca.sqrt(ca.dot(r_dot, t1) ** 2 + cm.reference_speed_m_s**2)
     xi_x, xi_y, phi = ca.dot(v_point, t1) / speed, ca.dot(v_point, t2) / speed, ca.dot(omega, n) / speed
@@ -313,6 +332,23 @@ def creep_terms(model, q, v, s, s_dot, normal_N) -> tuple[ca.MX, ca.MX]:
         total += ca.mtimes(_placement(e.rows, model.n_q).T, q_gen)
         records.append(rec)
     return total, (ca.vertcat(*records) if records else ca.MX(0, 1))
+
+
+def normal_directions(model, q: ca.MX, s: ca.MX) -> ca.MX:
+    """Per contact the weights ``w`` (3) of its normal force ``N = -w . lambda[r : r + 3]``, ``r``
+    its first constraint row (MX, 3 per contact): ``(0, 0, 1)`` in the rail-frame form (the gap
+    row), the rail's unit outward normal in the global form (the coincidence rows' force,
+    projected: linear in the multipliers, hence smooth for the solver, and equal to its
+    magnitude wherever ``C_s^T lambda = 0`` makes it normal to the rail)."""
+    out = []
+    for e in model.wheelrail:
+        if e.joint.form == "railframe":
+            out.append(ca.DM([0.0, 0.0, 1.0]))
+            continue
+        zeros = ca.MX.zeros(q.shape[0])
+        _, _, p = kernel_inputs(e, q, zeros, s, ca.MX.zeros(s.shape[0]))
+        out.append(e.normal_fn(s[e.s_index : e.s_index + 4], p))
+    return ca.vertcat(*out) if out else ca.MX(0, 1)
 
 
 def has_creep(model) -> bool:

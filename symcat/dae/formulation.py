@@ -31,6 +31,10 @@ contact's gap row (position, velocity or acceleration level) is replaced by its 
 (the four other rows), and the gap is free. :mod:`symcat.integrate.contact_switching` opens and
 closes them.
 
+Creep forces depend on the normal forces, linear in the multipliers
+(:meth:`Formulation.normal_forces`: minus the gap row's multiplier in the rail-frame form, minus
+the three coincidence rows' multipliers projected on the rail normal in the global form).
+
 Accelerations and multipliers are algebraic; the driver keeps them out of IDAS's error test.
 """
 from __future__ import annotations
@@ -44,7 +48,7 @@ import scipy.sparse as sps
 from ..assembly.contact import contact_terms
 from ..assembly.multibody import MultibodyModel
 from ..assembly.sparse import to_casadi_sparse
-from ..assembly.wheelrail import GAP_ROW, creep_terms, has_creep
+from ..assembly.wheelrail import GAP_ROW, creep_terms, has_creep, normal_directions
 from ..errors import ParameterError
 
 FORMULATIONS = ("augmented", "embedded")
@@ -191,7 +195,7 @@ class Formulation:
     def _release(self, rows, replacement, open_p):
         """``rows`` (the constraint rows of this form, or their multipliers' equations) with the
         gap rows of open contacts replaced by ``replacement`` (their multipliers)."""
-        index = self.normal_force_index()
+        index = self.gap_row_index()
         keep = self.releasable()
         if not keep:
             return rows
@@ -200,18 +204,48 @@ class Formulation:
         mask = ca.mtimes(ca.DM(to_casadi_sparse(sel)), open_p)
         return (1 - mask) * rows + mask * replacement
 
-    def normal_force_index(self) -> list[int]:
-        """Positions, in this form's multiplier vector, of the gap row of every wheel/rail
-        contact (its normal force is minus that multiplier)."""
+    def gap_row_index(self) -> list[int]:
+        """Positions, in this form's multiplier vector, of row 2 of every wheel/rail contact: the
+        gap row of the rail-frame form (its normal force is minus that multiplier)."""
         rows = [e.row_start + GAP_ROW for e in self.model.wheelrail]
         if self.formulation == "augmented":
             return rows
         return [self.rows_r.index(r) for r in rows]
 
+    def normal_force_rows(self, full: bool = False) -> np.ndarray:
+        """(n_w, 3) positions of the multipliers that carry each wheel/rail contact's normal force
+        (:func:`symcat.assembly.wheelrail.normal_directions` weighs them): its rows 0-2 in this
+        form's multiplier vector, or in the model's rows with ``full``. The embedded form keeps
+        only the gap row of a (rail-frame) contact; its weightless rows 0-1 point there too."""
+        rows = np.array([[e.row_start + i for i in range(3)] for e in self.model.wheelrail], int).reshape(-1, 3)
+        if full or self.formulation == "augmented":
+            return rows
+        gap = self.gap_row_index()
+        return np.array([[g, g, g] for g in gap], int).reshape(-1, 3)
+
+    def normal_forces(self, q, s, lam):
+        """Normal force (N) of every wheel/rail contact (MX) for all coordinates ``q``, surface
+        parameters ``s`` and this form's multipliers ``lam``."""
+        if not self.model.wheelrail:
+            return ca.MX(0, 1)
+        w = normal_directions(self.model, q, s)
+        rows = self.normal_force_rows()
+        return ca.vertcat(*[-ca.dot(w[3 * k : 3 * k + 3], lam[list(r)]) for k, r in enumerate(rows)])
+
+    def normal_direction_function(self) -> ca.Function:
+        """``(q, s) -> w`` (3 per wheel/rail contact; free internal coordinates ``q``): the weights
+        of :func:`symcat.assembly.wheelrail.normal_directions` (numeric use, see
+        :func:`normal_forces_numeric`)."""
+        if getattr(self, "_normal_fn", None) is None:
+            q, s = ca.MX.sym("q", self.n_f), ca.MX.sym("s", self.n_s)
+            w = normal_directions(self.model, self.q_fixed + ca.mtimes(self.P, q), s)
+            self._normal_fn = ca.Function("normal_directions", [q, s], [w], ["q", "s"], ["w"])
+        return self._normal_fn
+
     def creep_force(self, k: dict, s, s_dot, lam):
         """Generalized creep forces in free coordinates and the creep record (see
         :func:`symcat.assembly.wheelrail.creep_terms`) for multipliers ``lam`` of this form."""
-        normal = -lam[self.normal_force_index()] if self.model.wheelrail else ca.MX(0, 1)
+        normal = self.normal_forces(k["q"], s, lam)
         q_c, record = creep_terms(self.model, k["q"], k["v"], s, s_dot, normal)
         return ca.mtimes(self.P.T, q_c), record
 
@@ -324,3 +358,24 @@ def _layout(entries) -> dict[str, Block]:
         out[name] = Block(name, start, size)
         start += size
     return out
+
+
+def normal_forces_numeric(weights, lam, rows) -> np.ndarray:
+    """Normal forces ``N_k = -w_k . lam[rows_k]`` of the wheel/rail contacts (numeric).
+
+    Parameters
+    ----------
+    weights : ndarray (..., 3 n_w)
+        :meth:`Formulation.normal_direction_function`'s output, one row per state.
+    lam : ndarray (..., n_lam)
+        Multipliers, one row per state.
+    rows : ndarray (n_w, 3)
+        :meth:`Formulation.normal_force_rows` for the layout of ``lam``.
+
+    Returns
+    -------
+    ndarray (..., n_w)
+    """
+    w = np.asarray(weights, float)
+    w = w.reshape(w.shape[:-1] + (-1, 3))
+    return -(w * np.asarray(lam, float)[..., rows]).sum(axis=-1)

@@ -15,7 +15,7 @@ import scipy.sparse.linalg as spla
 
 from ..assembly.sparse import to_scipy
 from ..errors import SolverError
-from .formulation import Formulation
+from .formulation import Formulation, normal_forces_numeric
 
 
 def _terms_function(form: Formulation) -> ca.Function:
@@ -162,13 +162,15 @@ class CreepCoupling:
     over the linear solve ``solve(force) -> (..., multipliers)`` (creep forces are small against
     the normal forces and, for the linear law, independent of them: two or three passes)."""
 
-    def __init__(self, form: Formulation, q, v, s, w, index=None):
+    def __init__(self, form: Formulation, q, v, s, w):
         from ..assembly.wheelrail import has_creep
 
         self.active = has_creep(form.model)
         if self.active:
-            # Where the normal forces sit in the multipliers (default: the form's own layout).
-            self.index = form.normal_force_index() if index is None else index
+            # The multipliers of solve() are in the form's own layout.
+            weights = np.asarray(form.normal_direction_function()(q, s)).ravel()
+            rows = form.normal_force_rows()
+            self.normal = lambda lam: normal_forces_numeric(weights, np.asarray(lam).ravel(), rows)
             fn = form.creep_function()
             self.force = lambda normal: np.asarray(fn(q, v, s, w, normal)[0]).ravel()
 
@@ -176,17 +178,17 @@ class CreepCoupling:
         out = solve(f)
         if not self.active:
             return out
-        normal = -np.asarray(out[-1])[self.index]
+        normal = self.normal(out[-1])
         for _ in range(max_iterations):
             out = solve(f + self.force(normal))
-            new = -np.asarray(out[-1])[self.index]
+            new = self.normal(out[-1])
             if _settled(new, normal, tol):
                 return out
             normal = new
         raise _unsettled(max_iterations, new)
 
 
-def settle_creep(solves, f, creep_force, index, tol: float = 1e-10, max_iterations: int = 50) -> list:
+def settle_creep(solves, f, creep_force, normal_of, tol: float = 1e-10, max_iterations: int = 50) -> list:
     """:meth:`CreepCoupling.solve` for many states at once, the creep forces of all of them
     evaluated in one call per pass; each state takes the passes it would take alone (the same
     results).
@@ -200,8 +202,8 @@ def settle_creep(solves, f, creep_force, index, tol: float = 1e-10, max_iteratio
     creep_force : callable
         ``creep_force(normal) -> (n, n_f)``: the creep forces of every state for its normal
         forces ``normal`` (n, n_w).
-    index : list of int
-        Where the normal forces sit in the multipliers (minus them).
+    normal_of : callable
+        ``normal_of(i, multipliers) -> (n_w,)``: the normal forces of state ``i``.
     tol, max_iterations
         As for :meth:`CreepCoupling.solve`.
 
@@ -216,7 +218,7 @@ def settle_creep(solves, f, creep_force, index, tol: float = 1e-10, max_iteratio
         If a state's normal forces do not settle.
     """
     outs = [solve(fi) for solve, fi in zip(solves, f)]
-    normal = np.array([-np.asarray(out[-1])[index] for out in outs]).reshape(len(outs), len(index))
+    normal = np.array([normal_of(i, out[-1]) for i, out in enumerate(outs)]).reshape(len(outs), -1)
     pending = list(range(len(outs)))
     for _ in range(max_iterations):
         if not pending:
@@ -225,7 +227,7 @@ def settle_creep(solves, f, creep_force, index, tol: float = 1e-10, max_iteratio
         still = []
         for i in pending:
             outs[i] = solves[i](f[i] + force[i])
-            new = -np.asarray(outs[i][-1])[index]
+            new = normal_of(i, outs[i][-1])
             if not _settled(new, normal[i], tol):
                 still.append(i)
             normal[i] = new

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..assembly.wheelrail import GAP_ROW, TANGENCY_ROWS
+from ..dae.formulation import normal_forces_numeric
 from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
 from .failure import physical_coordinates, restart_point, split_state
@@ -298,7 +299,8 @@ def lost_contact(form, x, z, checks) -> str | None:
     force of the vanishing point grows without bound either way, and the point is about to jump."""
     model = form.model
     parts = split_state(form, x, z)
-    normal = -np.asarray(parts["lambda"])[form.normal_force_index()]
+    weights = np.asarray(form.normal_direction_function()(parts["q"], parts["s"])).ravel()
+    normal = normal_forces_numeric(weights, np.asarray(parts["lambda"]), form.normal_force_rows())
     releasable = form.releasable()  # these open instead (see contact_switching)
     for k, (e, n, check) in enumerate(zip(model.wheelrail, normal, checks)):
         s = parts["s"][e.s_index : e.s_index + 4]

@@ -50,9 +50,14 @@ class Switch:
 
 
 def normal_forces(form, z) -> np.ndarray:
-    """Normal force (N) of every wheel/rail contact at the algebraic state ``z``."""
+    """Normal force (N) of every releasable wheel/rail contact at the algebraic state ``z``
+    (minus its gap row's multiplier); NaN for the others (global form: they cannot open, and
+    their normal force needs the positions, see :func:`.contact_jumps.lost_contact`)."""
     lam = np.asarray(z)[form.blocks()[1]["lambda"].slice]
-    return -lam[form.normal_force_index()]
+    normal = np.full(len(form.model.wheelrail), np.nan)
+    keep = form.releasable()
+    normal[keep] = -lam[np.asarray(form.gap_row_index(), int)[keep]]
+    return normal
 
 
 def contact_gaps(form, x, z) -> np.ndarray:

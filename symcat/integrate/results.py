@@ -13,7 +13,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from ..assembly.wheelrail import GAP_ROW
-from ..dae.formulation import Formulation
+from ..dae.formulation import Formulation, normal_forces_numeric
 from ..dae.initial import KKTPattern, settle_creep
 
 @dataclass
@@ -47,7 +47,9 @@ class SimulationResult:
         Penalty contact name -> ``{"s_m", "gap_m", "force_N"}`` histories (n_t,): arc length,
         normal gap (> 0 separated) and normal force.
     wheelrail : dict
-        Wheel/rail contact name -> histories: ``normal_force_N`` (n_t,), the surface parameters
+        Wheel/rail contact name -> histories: ``normal_force_N`` (n_t,; minus the gap row's
+        multiplier in the rail-frame form, minus the coincidence rows' multipliers projected on
+        the rail's outward normal in the global form: the force the creep laws use), the surface parameters
         ``s`` (n_t, 4: s1w m, s2w rad, s1r m, s2r m), ``xi_x``, ``xi_y`` (-), ``phi_per_m``
         (spin, 1/m), the creep forces ``fx_N``, ``fy_N``, ``mz_Nm`` (zero without creep), the
         normal gap ``gap_m`` (> 0 separated; the constraint drift while in contact), ``open``
@@ -119,6 +121,7 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events) -> Simul
     lam = np.zeros((n_t, model.n_c))
     s_dot = np.zeros((n_t, form.n_s))
     creep_record = np.zeros((n_t, 6 * n_w))
+    normal = np.zeros((n_t, n_w))
     wheel_gap = np.zeros((n_t, n_w))
     pos, vel, kin, pot = (np.zeros(n_t) for _ in range(4))
     reactions = {name: np.zeros((n_t, 3)) for name in post.reactions.names}
@@ -137,6 +140,8 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events) -> Simul
             # Multipliers from the KKT system at each output (exact for the state, whatever
             # IDAS's tolerance on algebraic variables): the same for every formulation.
             a, lam[rows], creep_record[rows] = post.multipliers(chunk, terms, open_rows[rows])
+            if n_w:
+                normal[rows] = post.normal_forces(chunk, lam[rows])
         else:
             a = post.accelerations(terms)
         for i, a_i in zip(range(rows.start, rows.stop), a):
@@ -153,7 +158,7 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events) -> Simul
         stats=stats, a=acc,
         contacts={ct.joint.name: {"s_m": sc[:, k], "gap_m": gaps[:, k], "force_N": contact_forces[:, k]}
                   for k, ct in enumerate(model.contacts)},
-        wheelrail={e.joint.name: {"normal_force_N": _normal_force(e, lam), "s": s[:, e.s_index : e.s_index + 4],
+        wheelrail={e.joint.name: {"normal_force_N": normal[:, k], "s": s[:, e.s_index : e.s_index + 4],
                                   "gap_m": wheel_gap[:, k], "open": np.array([o[k] for o in opens], bool),
                                   **{f"{kind.replace('-', '_')}_s": np.array([ev.t_s for ev in events if ev.name == e.joint.name
                                                                               and ev.kind == kind]) for kind in ("lift-off", "touchdown")},
@@ -226,6 +231,7 @@ class _Mapped:
         if n not in self._maps:
             self._maps[n] = self.fn.map(n)
         out = self._maps[n](*(np.asarray(r, float).T for r in rows))
+        out = out if isinstance(out, (list, tuple)) else [out]  # one output comes back bare
         # reshape: an empty output may come back 0 x 0
         return [np.asarray(o).reshape(size, n).T for o, size in zip(out, self._sizes)]
 
@@ -244,7 +250,8 @@ class _PostTerms:
         fn, self.patterns = _terms_function(form)
         self._terms, self._names = _Mapped(fn), fn.name_out()
         self.creep = _Mapped(form.creep_function()) if has_creep(model) else None
-        self.normal_rows = [e.row_start + GAP_ROW for e in model.wheelrail]  # the gap rows (augmented layout)
+        self._normal = _Mapped(form.normal_direction_function()) if model.wheelrail else None
+        self.normal_rows = form.normal_force_rows(full=True)  # the KKT multipliers have every row
         self._kkt = {}  # open rows -> KKTPattern
         self.reactions = _ReactionMap(model, self.patterns["Cq"])
 
@@ -252,6 +259,15 @@ class _PostTerms:
         """The terms (n, size) of the outputs of ``state`` (internal coordinates) at times ``t``."""
         out = self._terms(state["q"], state["v"], state["s"], state["w"], t, state["sc"])
         return dict(zip(self._names, out))
+
+    def normal_directions(self, state: dict) -> np.ndarray:
+        """(n, 3 n_w) weights of the normal forces in the multipliers (see
+        :meth:`Formulation.normal_direction_function`)."""
+        return self._normal(state["q"], state["s"])[0]
+
+    def normal_forces(self, state: dict, lam: np.ndarray) -> np.ndarray:
+        """(n, n_w) normal forces (N) for the multipliers ``lam`` (n, n_c) of ``state``."""
+        return normal_forces_numeric(self.normal_directions(state), lam, self.normal_rows)
 
     def multipliers(self, state: dict, terms: dict, open_rows) -> tuple:
         """Accelerations (free, internal), multipliers (n, n_c) and creep records (n, 6 n_w) from
@@ -263,9 +279,11 @@ class _PostTerms:
             lam = np.array([out[2] for out in outs]).reshape(n, self.form.n_c)
             return [out[0] for out in outs], lam, np.zeros((n, 6 * len(self.normal_rows)))
         args = (state["q"], state["v"], state["s"], terms["s_dot"])
-        outs = settle_creep(solves, terms["Q"], lambda normal: self.creep(*args, normal)[0], self.normal_rows)
+        weights = self.normal_directions(state)
+        outs = settle_creep(solves, terms["Q"], lambda normal: self.creep(*args, normal)[0],
+                            lambda i, lam_i: normal_forces_numeric(weights[i], lam_i, self.normal_rows))
         lam = np.array([out[2] for out in outs]).reshape(n, self.form.n_c)
-        return [out[0] for out in outs], lam, self.creep(*args, -lam[:, self.normal_rows])[1]
+        return [out[0] for out in outs], lam, self.creep(*args, normal_forces_numeric(weights, lam, self.normal_rows))[1]
 
     def _solver(self, terms: dict, i: int, open_rows):
         """``solve(force)`` of output ``i``'s KKT system, its rows ``open_rows`` released."""
@@ -310,15 +328,6 @@ def _terms_function(form: Formulation) -> tuple[ca.Function, dict]:
     fn = ca.Function("post", [qs, vs, ss, ws, ts, scs], list(outs.values()),
                      ["q", "v", "s", "w", "t", "sc"], list(outs))
     return fn, {name: x.sparsity() for name, x in sparse.items()}
-
-
-def _normal_force(entry, lam) -> np.ndarray:
-    """Normal force (N) of a wheel/rail contact from the multipliers: minus that of the gap row
-    (eq. 22), or, for eq. 21 (frictionless), the magnitude of the three distance rows' force."""
-    rows = lam[:, entry.row_start : entry.row_start + 3]
-    if entry.joint.form == "railframe":
-        return -rows[:, 2]
-    return -np.sign(rows[:, 2]) * np.linalg.norm(rows, axis=1)
 
 
 class _ReactionMap:

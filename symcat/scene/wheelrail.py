@@ -1,8 +1,8 @@
 """Wheel/rail contact of a rigid wheelset on a ground-fixed rail (seed paper, Section 4).
 
 A :class:`WheelRailJoint` is one wheel on one rail: four surface parameters and five
-constraints (seed eqs. 15-22, see :mod:`symcat.symbolic.wheelrail`), with the normal force as
-the Lagrange multiplier of the gap row. Its optional :class:`CreepModel` adds the tangential
+constraints (seed eqs. 15-22, see :mod:`symcat.symbolic.wheelrail`), the normal force coming
+from their Lagrange multipliers (:func:`symcat.assembly.wheelrail.normal_directions`). Its optional :class:`CreepModel` adds the tangential
 creep forces at the contact point (assembled in :mod:`symcat.assembly.wheelrail`).
 """
 from __future__ import annotations
@@ -91,7 +91,14 @@ class WheelRailJoint:
     cant_rad : float
         Cant of a tangent track's cross-section (rad); 0 with a layout (it has its own).
     form : {"railframe", "global"}
-        Constraint form: eq. 22 (default; needed by the embedded formulation) or eq. 21.
+        Constraint form: eq. 22 (default) or eq. 21. Rail frame: rows 0-1 are the coincidence
+        of the wheel and rail points along the rail's tangents, row 2 their normal gap (its
+        multiplier is minus the normal force), rows 3-4 the tangency; only this form can lift
+        off (:mod:`symcat.integrate.contact_switching`) and run in the embedded formulation.
+        Global: rows 0-2 are the coincidence ``r^w - r^r`` in global components, rows 3-4 the
+        tangency; the normal force is minus their multipliers projected on the rail's outward
+        normal (``C_s^T lambda = 0`` makes them normal to the rail); a negative one ends the
+        run. Both forms take creep forces and move a wheelset the same.
     creep : CreepModel, optional
         Creep forces; none (frictionless) by default.
     track_piece_length_m : float
@@ -117,9 +124,6 @@ class WheelRailJoint:
             raise ParameterError(f"wheel/rail contact {self.name!r}: creep={self.creep!r} must be a CreepModel or None")
         if self.form not in ("railframe", "global"):
             raise ParameterError(f"wheel/rail contact {self.name!r}: form={self.form!r} must be 'railframe' or 'global'")
-        if self.creep is not None and self.form != "railframe":
-            raise ParameterError(f"wheel/rail contact {self.name!r}: creep forces need form='railframe' (the "
-                                 "normal force is the multiplier of its gap row)")
 
     def contact(self):
         """The run-time contact (:class:`symcat.wheelrail.WheelRailContact`) of this joint."""

@@ -63,6 +63,61 @@ class Irregularities:
         return out
 
 
+def read_irregularities(path, start_m: float = 0.0) -> Irregularities:
+    """Measured irregularities from a CSV file.
+
+    The file has a header row naming its columns, comma-separated, and one row per position:
+    ``s_m`` (required: distance along the track [m], at least 4 strictly increasing values) and
+    any of ``alignment_m``, ``level_m``, ``cross_level_m``, ``gauge_m`` (as :class:`Irregularities`
+    takes them [m]; omitted ones are zero). Lines starting with ``#`` are comments.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    start_m : float
+        Added to ``s_m`` (e.g. the chainage of the point the file's ``s_m = 0`` refers to) [m].
+
+    Raises
+    ------
+    ParameterError
+        For a missing or unreadable file, an unknown or missing column, a value that is not a
+        number, or data :class:`Irregularities` refuses; the message names the file.
+    """
+    columns = _read_columns(path)
+    unknown = sorted(set(columns) - {"s_m", *Irregularities.NAMES})
+    if "s_m" not in columns or unknown:
+        raise ParameterError(f"{path}: columns {', '.join(columns) or 'none'}; need s_m and any of "
+                             f"{', '.join(Irregularities.NAMES)}" + (f" (unknown: {', '.join(unknown)})" if unknown else ""))
+    try:
+        return Irregularities(columns.pop("s_m") + float(start_m), **columns)
+    except ParameterError as err:
+        raise ParameterError(f"{path}: {err}") from None
+
+
+def _read_columns(path) -> dict:
+    """Header name -> values (float arrays) of a comma-separated file with a header row."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            lines = [line.strip() for line in f if line.strip() and not line.lstrip().startswith("#")]
+    except (OSError, UnicodeDecodeError) as err:
+        raise ParameterError(f"{path}: cannot be read ({err.strerror if isinstance(err, OSError) else err})") from None
+    if not lines:
+        raise ParameterError(f"{path}: empty; needs a header row (s_m, ...) and data rows")
+    names = [n.strip() for n in lines[0].split(",")]
+    rows = []
+    for number, line in enumerate(lines[1:], start=2):
+        cells = line.split(",")
+        try:
+            values = [float(c) for c in cells]
+        except ValueError:
+            raise ParameterError(f"{path}: data row {number} ({line!r}) has a value that is not a number") from None
+        if len(values) != len(names):
+            raise ParameterError(f"{path}: data row {number} has {len(values)} values for {len(names)} columns")
+        rows.append(values)
+    data = np.array(rows, float).reshape(len(rows), len(names))
+    return {name: data[:, k] for k, name in enumerate(names)}
+
+
 ERRI_B176 = {"low": 2.119e-7, "high": 4.032e-7, "omega_c": 0.8246, "omega_r": 0.0206}
 
 

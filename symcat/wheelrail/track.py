@@ -50,7 +50,8 @@ import numpy as np
 
 from symcat.errors import ParameterError
 
-from .irregularities import Irregularities, _positive, erri_b176_psd, synthetic_irregularities  # noqa: F401
+from .irregularities import (Irregularities, _positive, erri_b176_psd, read_irregularities,  # noqa: F401
+                             synthetic_irregularities)
 from .track_parts import Curve, FramePiece, RailFrame, Tangent, Transition, rail_offset_for  # noqa: F401
 
 #: Lateral distance from the track centre to the UIC60 1:40 profile origin for a 1.435 m gauge

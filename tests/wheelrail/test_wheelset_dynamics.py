@@ -96,6 +96,34 @@ def test_global_and_rail_frame_forms_roll_the_same_wheelset(profile, atol_m):
     assert glob.stats.get("contact_jumps", 0) == rail.stats.get("contact_jumps", 0)
 
 
+@pytest.mark.parametrize("law", ["linear", "polach"])
+def test_global_and_rail_frame_forms_roll_the_same_wheelset_with_creep(law):
+    """Creep forces with either constraint form: the normal force of an eq. 21 contact is its
+    coincidence rows' force projected on the rail normal (eq. 22: minus the gap row's
+    multiplier). A wheelset rolling at 10 m/s from a 3 mm offset under Kalker's linear or
+    Polach's law (over 1 s, about 60 % of its Klingel period) moves the same under either form
+    (1e-11 m measured), with the same normal and creep forces (normal forces to 1e-7 relative
+    measured; creep forces to 0.015 N, velocities agreeing to the integration tolerance, against
+    normal forces of 9 kN and lateral creep forces of 390 N)."""
+    pair = profile_pair("conical", 0.05)
+    creep = CreepModel(law, nominal_normal_force_N=0.5 * MASS * G)
+    runs = {}
+    for form in ("global", "railframe"):
+        scene, _ = wheelset_scene(pair, offset=0.003, speed=10.0, creep=creep, form=form)
+        runs[form] = simulate(MultibodyModel(scene), 1.0, n_out=50, rtol=1e-9, progress=False)
+    glob, rail = runs["global"], runs["railframe"]
+    y = rail.coordinate("ws.y")
+    assert np.ptp(y) > 5e-3  # it oscillates
+    np.testing.assert_allclose(glob.coordinate("ws.y"), y, rtol=0, atol=1e-7)
+    for side in ("wr_left", "wr_right"):
+        g, r = glob.wheelrail[side], rail.wheelrail[side]
+        np.testing.assert_allclose(g["normal_force_N"], r["normal_force_N"], rtol=1e-5)
+        assert np.abs(r["fy_N"]).max() > 300.0  # creep forces at work
+        for key in ("fx_N", "fy_N"):
+            np.testing.assert_allclose(g[key], r[key], rtol=0, atol=1e-5 * r["normal_force_N"].max())
+        np.testing.assert_allclose(g["mz_Nm"], r["mz_Nm"], rtol=0, atol=1e-5 * max(np.abs(r["mz_Nm"]).max(), 1.0))
+
+
 def test_a_wheelset_off_the_rails_is_refused_with_its_gap():
     pair = profile_pair("conical")
     placed = wheelset_on_track(pair.wheel, pair.rail, 0.0)
