@@ -14,7 +14,11 @@ the multipliers. The constraint force on the wheelset is ``-C_q^T lambda``. In t
 form (eq. 22) the gap row's gradient is the rail's outward normal ``n``, so ``N = -lambda_gap``.
 In the global form (eq. 21) the three coincidence rows ``r^w - r^r`` have the identity as
 gradient in the wheelset position, so their force on the wheel is ``-lambda[0:3]``, normal to
-the rail surface where ``C_s^T lambda = 0`` holds; ``N = -n . lambda[0:3]``. The contact frame is ``t1`` the unit rail tangent along the track
+the rail surface where ``C_s^T lambda = 0`` holds; ``N = -n . lambda[0:3]``. The contact ellipse and
+Kalker's coefficients are computed in the same graph at the current contact point
+(:func:`contact_ellipse`, :mod:`.creep_ellipse`): from the curvatures of the selected cubic
+pieces, so they follow the point across the profiles. The contact frame is ``t1`` the unit rail
+tangent along the track
 at the contact (rolling direction: global ``x`` on tangent track), ``n`` the rail's outward
 normal there, ``t2 = n x t1``; the creepages are the material point's velocity along ``t1, t2``
 and the wheelset's angular velocity along ``n``, divided by ``V = sqrt((R_dot . t1)^2 +
@@ -36,9 +40,11 @@ import numpy as np
 
 from ..codegen.library import kernel_library
 from .contact import _placement
+from .creep_ellipse import (hertz_semi_axes_sx, kalker_coefficients_sx, plane_curvature_sx,
+                            relative_curvatures_sx)
 from ..errors import ParameterError, SolverError
 from ..scene.rigid import RigidBody
-from ..scene.wheelrail import WheelRailJoint
+from ..scene.wheelrail import CreepModel, WheelRailJoint
 from ..wheelrail.creep import SHEAR_MODULUS_STEEL_PA, kalker_coefficients, kalker_linear_forces
 from ..wheelrail.hertz import hertz_contact, relative_curvatures
 
@@ -52,7 +58,10 @@ PLACEMENT_TOLERANCE_M = 2e-3
 
 @dataclass
 class CreepSetup:
-    """Contact ellipse and Kalker coefficients at the nominal load (see :class:`CreepModel`)."""
+    """Contact ellipse and Kalker coefficients (times the model's ``coefficient_factor``) at the
+    nominal load and the *initial* contact point (see :class:`CreepModel`): the values the creep
+    function starts from (it recomputes them at the current contact point) and those of a linear
+    analysis about the initial state."""
 
     a_m: float
     b_m: float
@@ -129,14 +138,17 @@ def add_wheelrail(model, joint: WheelRailJoint) -> WheelRailEntry:
 
 
 def creep_setup(joint: WheelRailJoint, contact, point) -> CreepSetup:
-    """Hertz ellipse and Kalker coefficients at the nominal load and the initial contact point."""
+    """Hertz ellipse and Kalker coefficients at the nominal load and the initial contact point
+    (NumPy: :func:`symcat.wheelrail.hertz.hertz_contact`, :func:`kalker_coefficients`).
+
+    Raises
+    ------
+    ParameterError
+        If the profiles have no Hertz ellipse there (conformal or concave relative surface).
+    """
     cm = joint.creep
-    s1w, s2r = point.s[0], point.s[3]
-    # Profile.curvature is positive for hollows; Hertz wants convex positive.
-    k_wheel = -float(contact.wheel.curvature(s1w))
-    k_rail = -float(contact.rail.curvature(s2r))
     try:
-        A, B = relative_curvatures(point.rolling_radius_m, k_wheel, k_rail, point.contact_angle_rad)
+        A, B = relative_curvatures(*contact_curvatures(contact.wheel, contact.rail, point.s, point.rolling_radius_m))
         ellipse = hertz_contact(cm.nominal_normal_force_N, A, B)
     except ParameterError as err:
         raise ParameterError(f"wheel/rail contact {joint.name!r}: no Hertz ellipse at the initial contact point "
@@ -146,6 +158,25 @@ def creep_setup(joint: WheelRailJoint, contact, point) -> CreepSetup:
     f = cm.coefficient_factor
     return CreepSetup(a, b, f * float(c.c11), f * float(c.c22), f * float(c.c23), f * float(c.c33),
                       cm.nominal_normal_force_N)
+
+
+def contact_curvatures(wheel, rail, s, rolling_radius_m):
+    """Arguments of :func:`symcat.wheelrail.hertz.relative_curvatures` at surface parameters
+    ``s``, as the creep function computes them in its graph (NumPy).
+
+    The profile curvatures are negated (``Profile.curvature`` is positive for hollows, Hertz
+    wants convex positive). The angle is that of the wheel's profile normal to its radius,
+    ``atan(dz/dy)`` of the wheel profile: the angle of Meusnier's theorem for the wheel's
+    curvature along the rolling direction (the track-plane ``ContactPoint.contact_angle_rad``
+    differs from it by the wheelset's roll).
+
+    Returns
+    -------
+    (rolling_radius_m, wheel_curvature_per_m, rail_curvature_per_m, contact_angle_rad)
+    """
+    d = wheel.derivative(s[0])
+    return (float(rolling_radius_m), -float(wheel.curvature(s[0])), -float(rail.curvature(s[3])),
+            float(np.arctan2(-d[1], d[0])))
 
 
 def _rotation(th):
@@ -158,6 +189,33 @@ def _rotation(th):
 def _cubic(s, s0, c):
     d = s - s0
     return c[0] * d**3 + c[1] * d**2 + c[2] * d + c[3], 3 * c[0] * d**2 + 2 * c[1] * d + c[2]
+
+
+def _cubic_slopes(s, s0, c):
+    """First and second derivative of the cubic piece of :func:`_cubic`."""
+    d = s - s0
+    return 3 * c[0] * d**2 + 2 * c[1] * d + c[2], 6 * c[0] * d + 2 * c[1]
+
+
+def _piece_curvature(s, s0, cy, cz):
+    """Curvature (1/m) of a profile's cubic piece at ``s``, convex positive (Hertz's sign,
+    the negative of ``Profile.curvature``), and the ``y`` and ``z`` slopes ``dy/ds, dz/ds``."""
+    dy, ddy = _cubic_slopes(s, s0, cy)
+    dz, ddz = _cubic_slopes(s, s0, cz)
+    return -plane_curvature_sx(dy, dz, ddy, ddz), dy, dz
+
+
+def contact_ellipse(p, s, normal_N, creep: CreepModel):
+    """Semi-axes ``a, b`` (m) and Kalker's coefficients (times ``coefficient_factor``) at the
+    contact point of surface parameters ``s`` (SX), kernel parameters ``p``, normal force
+    ``normal_N``: the graph form of :func:`creep_setup` (see :func:`contact_curvatures`)."""
+    z_w, _ = _cubic(s[0], p[6], p[11:15])
+    k_wheel, dy_w, dz_w = _piece_curvature(s[0], p[6], p[7:11], p[11:15])
+    k_rail, _, _ = _piece_curvature(s[3], p[15], p[16:20], p[20:24])
+    cos_angle = dy_w / ca.sqrt(dy_w**2 + dz_w**2)
+    A, B = relative_curvatures_sx(p[1] + z_w, cos_angle, k_wheel, k_rail)
+    a, b = hertz_semi_axes_sx(normal_N, A, B)
+    return a, b, kalker_coefficients_sx(a / b, factor=creep.coefficient_factor)
 
 
 def _rail_tangents(p, s, curved: bool):
@@ -227,14 +285,15 @@ def creep_function(joint: WheelRailJoint, setup: CreepSetup, curved: bool = Fals
     cm = joint.creep
     speed = ca.sqrt(ca.dot(r_dot, t1) ** 2 + cm.reference_speed_m_s**2)
     xi_x, xi_y, phi = ca.dot(v_point, t1) / speed, ca.dot(v_point, t2) / speed, ca.dot(omega, n) / speed
-    coeff = (setup.c11, setup.c22, setup.c23, setup.c33)
+    # the ellipse at the nominal load and the current contact point
+    a_m, b_m, coeff = contact_ellipse(p, s, setup.nominal_normal_force_N, cm)
     if cm.law == "linear":
-        fx, fy, mz = kalker_linear_forces(xi_x, xi_y, phi, setup.a_m, setup.b_m, coeff)
+        fx, fy, mz = kalker_linear_forces(xi_x, xi_y, phi, a_m, b_m, coeff)
     else:
         # The multiplier may dip below zero where the constraint holds the wheel down.
         n_pos = smooth_positive(normal, 1e-3 * setup.nominal_normal_force_N)
         scale = (n_pos / setup.nominal_normal_force_N) ** (1.0 / 3.0)
-        fx, fy, mz = polach_forces_casadi(xi_x, xi_y, phi, n_pos, setup.a_m * scale, setup.b_m * scale, coeff,
+        fx, fy, mz = polach_forces_casadi(xi_x, xi_y, phi, n_pos, a_m * scale, b_m * scale, coeff,
                                           friction_coefficient=cm.friction_coefficient)
     force = fx * t1 + fy * t2
     moment = mz * n

@@ -19,13 +19,16 @@ CREEP_LAWS = ("linear", "polach")
 class CreepModel:
     """Creep forces of one contact.
 
-    The contact ellipse and Kalker's coefficients are computed once, by Hertz's theory at
-    ``nominal_normal_force_N`` and the local curvatures of the initial contact point (the
-    usual practice of linear analyses; their change with the contact point's position on the
-    profile is neglected). ``linear`` is Kalker's linear theory with these constant
-    coefficients. ``polach`` is Polach's saturating law with friction coefficient
-    ``friction_coefficient``; its ellipse grows with the actual normal force (the multiplier)
-    as ``(N / N_nominal)^(1/3)`` at fixed shape.
+    The contact ellipse and Kalker's coefficients follow the contact point: inside the creep
+    function's graph they are computed by Hertz's theory at ``nominal_normal_force_N`` from the
+    profile curvatures at the current contact point (wheel and rail profile curvature across,
+    ``cos(angle) / r`` of the wheel along the rolling direction), so they change as the point
+    moves over a worn profile and jumps between tread, flange root and flange flank
+    (:mod:`symcat.assembly.creep_ellipse`; a nearly conformal contact is floored at
+    ``B >= 1e-3 A``). ``linear`` is Kalker's linear theory with these coefficients. ``polach``
+    is Polach's saturating law with friction coefficient ``friction_coefficient``; its ellipse
+    also grows with the actual normal force (the multiplier) as ``(N / N_nominal)^(1/3)`` at
+    the shape of the nominal load.
 
     Parameters
     ----------

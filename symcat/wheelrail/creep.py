@@ -57,6 +57,7 @@ __all__ = [
     "fastsim_forces",
     "kalker_coefficients",
     "kalker_linear_forces",
+    "kalker_pieces",
     "polach_forces",
     "polach_friction_coefficient",
     "shen_hedrick_elkins_forces",
@@ -140,19 +141,50 @@ def kalker_coefficients(a_over_b, poisson_ratio=POISSON_RATIO_STEEL, clamp=False
     elif np.any(~((ratio >= lo * (1 - 1e-12)) & (ratio <= hi * (1 + 1e-12)))):
         raise ParameterError(
             f"a_over_b must lie in Kalker's table range [{lo}, {hi}] (or clamp=True), got {a_over_b}")
+    weights = _poisson_weights(poisson_ratio)
+    table = interpolant(np.clip(np.log(ratio), np.log(lo), np.log(hi)))
+    table = table.reshape(ratio.shape + (4, 3))
+    c = table @ weights
+    return KalkerCoefficients(c[..., 0], c[..., 1], c[..., 2], c[..., 3])
+
+
+def kalker_pieces(poisson_ratio=POISSON_RATIO_STEEL):
+    """The piecewise cubic behind :func:`kalker_coefficients` at one Poisson ratio.
+
+    For evaluating the coefficients elsewhere (in a CasADi graph): on piece ``i``,
+    ``C(x) = sum_j coefficients[j, i] (x - breaks[i])**(3 - j)`` with ``x = ln(a/b)``
+    in ``[breaks[0], breaks[-1]]`` (the table range; clamp outside).
+
+    Parameters
+    ----------
+    poisson_ratio : float
+        In [0, 0.5]; default 0.3.
+
+    Returns
+    -------
+    breaks : ndarray (n + 1,)
+        ``ln(a/b)`` at the table's nodes.
+    coefficients : ndarray (4, n, 4)
+        Polynomial coefficients (highest power first), piece, and C11, C22, C23, C33.
+    """
+    interpolant, _ = _kalker_table()
+    weights = _poisson_weights(poisson_ratio)
+    # the nu weights combine the 12 columns linearly, so they combine the polynomials too
+    c = interpolant.c.reshape(interpolant.c.shape[:2] + (4, 3)) @ weights
+    return np.array(interpolant.x), c
+
+
+def _poisson_weights(poisson_ratio):
+    """Lagrange weights of the table's three nu columns at ``poisson_ratio``."""
     nu = float(poisson_ratio)
     if not 0.0 <= nu <= 0.5:
         raise ParameterError(f"poisson_ratio must lie in [0, 0.5], got {poisson_ratio}")
-    table = interpolant(np.clip(np.log(ratio), np.log(lo), np.log(hi)))
-    table = table.reshape(ratio.shape + (4, 3))
     n0, n1, n2 = _TABLE_NU
-    weights = np.array([
+    return np.array([
         (nu - n1) * (nu - n2) / ((n0 - n1) * (n0 - n2)),
         (nu - n0) * (nu - n2) / ((n1 - n0) * (n1 - n2)),
         (nu - n0) * (nu - n1) / ((n2 - n0) * (n2 - n1)),
     ])
-    c = table @ weights
-    return KalkerCoefficients(c[..., 0], c[..., 1], c[..., 2], c[..., 3])
 
 
 # --------------------------------------------------------------------------
