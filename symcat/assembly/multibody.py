@@ -235,6 +235,11 @@ class MultibodyModel:
         """Sliding joints, then contacts: everything that has an element window."""
         return self.sliding + self.contacts
 
+    def windows_move(self) -> bool:
+        """Whether any element window can move: some sliding or contact point's wire has more
+        elements than :attr:`window_size` (else every window is its whole wire)."""
+        return any(len(sl.element_start) - 1 > self.window_size for sl in self.windowed())
+
     def window_margin(self, s: np.ndarray) -> float:
         """Smallest distance, in elements, from any sliding or contact point (``s`` in the order
         of :meth:`windowed`) to the edge of its window (a wire end counts as no edge)."""

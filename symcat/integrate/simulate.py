@@ -145,7 +145,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             # Output intervals grouped into spans of about CONTACT_GROUP_S (one per interval
             # with element windows, moved between intervals): the stepper's calls cross output
             # times, so dense output costs neither contact checks nor IDAS restarts.
-            group = 1 if model.windowed() else max(1, int(CONTACT_GROUP_S / (t_grid[1] - t_grid[0]) + 1e-9))
+            group = 1 if model.windows_move() else max(1, int(CONTACT_GROUP_S / (t_grid[1] - t_grid[0]) + 1e-9))
 
             def emit(j, x_j, z_j):
                 nonlocal done

@@ -165,3 +165,12 @@ def test_mass_sliding_on_a_taut_flexible_wire_against_a_modal_model():
     travel, amplitude = s_ref[-1] - s0, np.abs(z_ref).max()   # 10 mm and 7 mm
     assert errors[0][0] < 0.01 * travel and errors[0][1] < 0.025 * amplitude
     assert errors[1][0] < errors[0][0] and errors[1][1] < errors[0][1]
+
+
+def test_windows_move_only_on_wires_longer_than_the_window():
+    from symcat.model import load_model
+
+    slider = load_model("slider_on_wire")
+    scene = slider.run.__globals__["build"](slider.resolve({"n_elements": 12}))
+    assert MultibodyModel(scene, window=8).windows_move()
+    assert not MultibodyModel(scene, window=12).windows_move()
