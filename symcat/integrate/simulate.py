@@ -143,7 +143,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             stepper = ContactStepper(form, dae_fn, opts, x, z, stats, STAT_KEYS, open_flags)
             events = stepper.switching.events
             # Output intervals grouped into spans of about CONTACT_GROUP_S (one per interval
-            # with element windows, moved between intervals): the stepper's calls cross output
+            # where element windows can move, moved between intervals): the stepper's calls cross output
             # times, so dense output costs neither contact checks nor IDAS restarts.
             group = 1 if model.windows_move() else max(1, int(CONTACT_GROUP_S / (t_grid[1] - t_grid[0]) + 1e-9))
 
