@@ -85,6 +85,9 @@ PARAMETERS = [
               maximum=0.2),
     Parameter("transition_length_m", 20.0, "m", "clothoid transition ramping curvature and cant into the curve",
               minimum=0.0),
+    Parameter("cant_ramp", "smooth", "", "superelevation ramp of the transition: smooth (Bloss's cubic, no kinks "
+              "of the rails) or linear (its ends are kinks, impacts the vehicle's rigid contacts do not get past)",
+              choices=("smooth", "linear")),
     Parameter("t_end", 1.0, "s", "simulated time", minimum=0.0, exclusive_minimum=True),
     Parameter("index", "ggl", "", "constraint stabilization: GGL (positions held) or index 1 with Baumgarte",
               choices=("ggl", "1")),
@@ -113,7 +116,7 @@ def track_for(p: dict, pair, parameters: VehicleParameters):
                              "(curve_radius_m = 0)")
     return curve_track(pair, p["curve_radius_m"], cant_m=p["cant_m"], transition_length_m=p["transition_length_m"],
                        curve_length_m=p["speed_ms"] * p["t_end"] + 10.0, direction=p["curve_direction"],
-                       parameters=parameters)
+                       parameters=parameters, cant_ramp=p.get("cant_ramp", "smooth"))
 
 
 def irregular_track(p: dict, pair, parameters: VehicleParameters):
@@ -190,7 +193,8 @@ def run(p: dict) -> ModelOutput:
         res = simulate(model, p["t_end"], index=p["index"], rtol=p["rtol"], atol=p.get("atol") or 0.1 * p["rtol"],
                        n_out=int(p["n_out"]), progress=p.get("progress", True))
     except SolverError as err:
-        hint = "; in a canted curve index=1 (the cant ramps' ends are impacts)" if p.get("cant_m", 0.0) > 0 else ""
+        hint = ("; cant_ramp=smooth (the ends of a linear cant ramp are kinks of the rails, impacts the rigid "
+                "contacts do not get past)") if p.get("cant_m", 0.0) > 0 and p.get("cant_ramp") == "linear" else ""
         raise SolverError(f"{err} (vehicle model: try index=ggl or a tighter rtol{hint}; a flange contact or a contact "
                           "jump may have been reached)", partial=err.partial) from err
     summary = summarize(res, layout)

@@ -34,7 +34,7 @@ LEAD_IN_MARGIN_M = 1.0
 
 def curve_track(pair, radius_m: float, *, cant_m: float = 0.0, transition_length_m: float = 20.0,
                 curve_length_m: float = 100.0, direction: str = "left",
-                parameters: VehicleParameters | None = None) -> tuple[TrackLayout, float]:
+                parameters: VehicleParameters | None = None, cant_ramp: str = "smooth") -> tuple[TrackLayout, float]:
     """A tangent lead-in holding the whole vehicle, a clothoid transition and a circular curve.
 
     Parameters
@@ -54,6 +54,10 @@ def curve_track(pair, radius_m: float, *, cant_m: float = 0.0, transition_length
         Side of the curve centre.
     parameters : VehicleParameters, optional
         The vehicle (its length sets the lead-in).
+    cant_ramp : {"smooth", "linear"}
+        Superelevation ramp along the transition (:class:`symcat.wheelrail.track.Transition`):
+        ``"smooth"`` (no kinks of the rails) or ``"linear"`` (kinks at its ends, impacts that a
+        rigid wheel/rail contact of the vehicle does not get past).
 
     Returns
     -------
@@ -76,7 +80,7 @@ def curve_track(pair, radius_m: float, *, cant_m: float = 0.0, transition_length
     lead_in = 2.0 * (half + LEAD_IN_MARGIN_M)
     segments = [Tangent(lead_in)]
     if transition_length_m > 0:
-        segments.append(Transition(float(transition_length_m)))
+        segments.append(Transition(float(transition_length_m), cant_ramp))
     segments.append(Curve(float(curve_length_m), float(radius_m), direction, float(cant_m)))
     return TrackLayout(segments, rail_offset_m=rail_offset_for(pair.rail)), half + LEAD_IN_MARGIN_M
 

@@ -52,7 +52,7 @@ from symcat.errors import ParameterError
 
 from .irregularities import (Irregularities, _positive, erri_b176_psd, read_irregularities,  # noqa: F401
                              synthetic_irregularities)
-from .track_parts import Curve, FramePiece, RailFrame, Tangent, Transition, rail_offset_for  # noqa: F401
+from .track_parts import CANT_RAMPS, Curve, FramePiece, RailFrame, Tangent, Transition, rail_offset_for  # noqa: F401
 
 #: Lateral distance from the track centre to the UIC60 1:40 profile origin for a 1.435 m gauge
 #: measured 14 mm below the rail top (:func:`rail_offset_for` with the shipped profile) [m].
@@ -153,6 +153,8 @@ class TrackLayout:
                 h[i] = -sign * seg.cant_m  # the outer rail is the right one in a left curve
             if isinstance(seg, Transition) and i > 0 and isinstance(segs[i - 1], Transition):
                 raise ParameterError(f"{label}: follows another transition; put a tangent or curve between them")
+            if isinstance(seg, Transition) and seg.cant_ramp not in CANT_RAMPS:
+                raise ParameterError(f"{label} cant_ramp={seg.cant_ramp!r}: must be one of {', '.join(CANT_RAMPS)}")
         L = np.array([float(s.length_m) for s in segs])
         k0, k1, h0, h1 = kap.copy(), kap.copy(), h.copy(), h.copy()
         for i, seg in enumerate(segs):
@@ -169,6 +171,7 @@ class TrackLayout:
         self._dk = (k1 - k0) / L
         self._h0 = h0
         self._dh = (h1 - h0) / L
+        self._smooth = np.array([isinstance(g, Transition) and g.cant_ramp == "smooth" for g in segs])
         self.length_m = float(L.sum())
         # Segment starts and clothoid panel starts (plan x, y and heading there).
         ps, px, py = [], [], []
@@ -249,7 +252,22 @@ class TrackLayout:
     def superelevation(self, s_m) -> np.ndarray:
         """Signed superelevation ``h`` [m]: height of the left rail over the right one."""
         _, seg, u = self._locate(s_m)
-        return self._h0[seg] + self._dh[seg] * u
+        return self._superelevation(seg, u)[0]
+
+    def _superelevation(self, seg, u):
+        """``h`` [m] and its first two derivatives along the track at ``u`` [m] into segments
+        ``seg``: linear, or the smooth ramp ``3 x^2 - 2 x^3`` (:class:`Transition`)."""
+        rate = self._dh[seg]
+        h, dh, d2h = self._h0[seg] + rate * u, rate + 0.0 * u, 0.0 * u
+        smooth = self._smooth[seg]
+        if np.any(smooth):
+            length = self._L[seg][smooth]
+            x = u[smooth] / length
+            rise = rate[smooth] * length
+            h[smooth] = self._h0[seg][smooth] + rise * x * x * (3.0 - 2.0 * x)
+            dh[smooth] = rise * 6.0 * x * (1.0 - x) / length
+            d2h[smooth] = rise * (6.0 - 12.0 * x) / length**2
+        return h, dh, d2h
 
     def cant_angle(self, s_m) -> np.ndarray:
         """Cant angle ``phi = arcsin(h / cant_base_m)`` [rad], positive lifting the left rail."""
@@ -259,12 +277,12 @@ class TrackLayout:
         s, seg, u = self._locate(s_m, segment)
         k, dk = self._k0[seg] + self._dk[seg] * u, self._dk[seg]
         psi = self._psi0[seg] + self._k0[seg] * u + 0.5 * dk * u**2
-        h, dh = self._h0[seg] + self._dh[seg] * u, self._dh[seg]
+        h, dh, d2h = self._superelevation(seg, u)
         b = self.cant_base_m
         root = np.sqrt(b * b - h * h)
         phi = np.arcsin(h / b)
         dphi = dh / root
-        d2phi = dh * dh * h / root**3
+        d2phi = d2h / root + dh * dh * h / root**3
         # Plan position from the panel start (the last panel of the segment at a left limit).
         p = np.minimum(np.searchsorted(self._panel_s, s, side="right"),
                        np.searchsorted(self._panel_seg, seg, side="right")) - 1
@@ -283,11 +301,11 @@ class TrackLayout:
             ang = self._psi0[seg[cl]][:, None] + self._k0[seg[cl]][:, None] * g + 0.5 * dk[cl][:, None] * g**2
             step[cl] = half[:, None] * np.stack([np.cos(ang) @ _GL_W, np.sin(ang) @ _GL_W], axis=1)
         xy = self._panel_xy[p] + step
-        return s, xy, psi, k, dk, h, dh, phi, dphi, d2phi
+        return s, xy, psi, k, dk, h, dh, phi, dphi, d2phi, d2h
 
     # ----------------------------------------------------------------- frames
     def _frames(self, s_m, side: str | None, segment=None):
-        s, xy, psi, k, dk, h, dh, phi, dphi, d2phi = self._fields(s_m, segment)
+        s, xy, psi, k, dk, h, dh, phi, dphi, d2phi, d2h = self._fields(s_m, segment)
         n = s.size
         g = self.gradient
         cp, sp = np.cos(psi), np.sin(psi)
@@ -312,7 +330,7 @@ class TrackLayout:
             c = np.cos(phi)
             w[:, 1], w[:, 2] = -sg * 0.5 * b * (1.0 - c), 0.5 * np.abs(h)
             dw[:, 1], dw[:, 2] = -sg * 0.5 * b * np.sin(phi) * dphi, 0.5 * sg * dh
-            d2w[:, 1] = -sg * 0.5 * b * (c * dphi**2 + np.sin(phi) * d2phi)
+            d2w[:, 1], d2w[:, 2] = -sg * 0.5 * b * (c * dphi**2 + np.sin(phi) * d2phi), 0.5 * sg * d2h
         beta = 0.0
         if side is not None:
             sign = 1.0 if side == "left" else -1.0

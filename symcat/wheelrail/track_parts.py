@@ -39,13 +39,21 @@ class Curve:
     cant_m: float = 0.0
 
 
+#: Superelevation ramps of a :class:`Transition`.
+CANT_RAMPS = ("linear", "smooth")
+
+
 @dataclass(frozen=True)
 class Transition:
-    """Clothoid of ``length_m`` [m]: curvature and superelevation linear in ``s`` from those at
-    the end of the previous segment to those at the start of the next (a tangent before the
-    first or after the last segment)."""
+    """Clothoid of ``length_m`` [m]: curvature linear in ``s`` from that at the end of the
+    previous segment to that at the start of the next (a tangent before the first or after the
+    last segment), and the superelevation ramped between theirs: ``cant_ramp="linear"`` (the
+    classic ramp; its ends are kinks of the raised rail, crossed by a rigid wheel/rail contact
+    as impacts) or ``"smooth"`` (the cubic ``3 x^2 - 2 x^3`` of ``x = s / length_m``, Bloss's
+    cant: the cant rate starts and ends at zero, so the rails have no kinks)."""
 
     length_m: float
+    cant_ramp: str = "linear"
 
 
 @dataclass(frozen=True)

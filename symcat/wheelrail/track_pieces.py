@@ -20,7 +20,8 @@ rail frames already carry the rail offset, the low-rail cant pivot and irregular
 
 Smoothness: the pieces are C1 where the layout's rail frames are, so ``C`` and ``C_s`` are
 continuous across piece ends and ``Q_d`` jumps only where the layout's curvature rate does (the
-ends of a clothoid). A change of cant is a linear superelevation ramp, however, whose ends are
+ends of a clothoid). A smooth cant ramp (``Transition(..., cant_ramp="smooth")``) keeps the
+rails C1. A linear superelevation ramp, however, has ends that are
 kinks of the rails (the cant rate steps: the raised rail's slope drops by half the ramp's
 gradient, 4 mrad for 80 mm over 10 m) and creases of the rail surfaces; a rigid constraint
 contact crosses them as an impact. With the augmented formulation the driver's contact-jump
@@ -44,14 +45,17 @@ SIDES = {"left": 1.0, "right": -1.0}
 N_PIECE = 22
 
 
-def _cant_rate_steps(layout: TrackLayout, eps_m: float = 1e-4) -> np.ndarray:
-    """Interior segment joins [m] of ``layout`` where the superelevation's slope changes."""
-    joins = layout.joins_m[1:-1]
-    if joins.size == 0:
+def _cant_rate_steps(layout: TrackLayout) -> np.ndarray:
+    """Interior segment joins [m] of ``layout`` where the superelevation's slope changes (the ends
+    of linear cant ramps; a smooth ramp starts and ends at zero slope)."""
+    n = len(layout.segments)
+    if n < 2:
         return np.zeros(0)
-    h = [layout.superelevation(joins + d) for d in (-eps_m, 0.0, eps_m)]
-    step = np.abs((h[2] - h[1]) - (h[1] - h[0])) / eps_m
-    return joins[step > 1e-9]
+    seg = np.arange(n)
+    _, rate_end, _ = layout._superelevation(seg, layout._L.copy())
+    _, rate_start, _ = layout._superelevation(seg, np.zeros(n))
+    step = np.abs(rate_start[1:] - rate_end[:-1])
+    return layout.joins_m[1:-1][step > 1e-12]
 
 
 def rot_x(a: float) -> np.ndarray:
@@ -192,13 +196,19 @@ class TrackRailFrames:
         return self.table[int(self.index(s1r, clip)[0])].copy()
 
     def lookup(self, name: str) -> ca.Function:
-        """MX function ``s1r -> track piece (22)``: the piece found by a binary search
-        (``casadi.low``) and read from the table by a symbolic index, so its derivative is zero
-        and its cost does not grow with the number of pieces (the end pieces extend the track)."""
-        s = ca.MX.sym("s1r")
-        i = ca.low(ca.DM(self.breaks_m), s)
-        row = ca.MX(ca.DM(self.table))[i, :]
-        return ca.Function(name, [s], [ca.transpose(row)], ["s1r"], ["piece"])
+        """SX function ``s1r -> track piece (22)``: the sum of every piece's row times the
+        indicator of its interval (the end pieces extend the track), as the profiles' pieces are
+        picked (:func:`symcat.assembly.wheelrail.piece_lookup`). Its derivative is zero; unlike a
+        binary search with a symbolic index (``casadi.low``), it expands to SX, so that a model
+        on a track layout compiles whole (:mod:`symcat.codegen.model_dae`)."""
+        s = ca.SX.sym("s1r")
+        x, n = self.breaks_m, len(self.table)
+        out = ca.SX.zeros(self.table.shape[1])
+        for k in range(n):
+            below = s >= x[k] if k > 0 else 1
+            above = s < x[k + 1] if k < n - 1 else 1
+            out += below * above * ca.DM(self.table[k])
+        return ca.Function(name, [s], [out], ["s1r"], ["piece"])
 
     # ------------------------------------------------------------------ frames
     def _pieces(self, s):

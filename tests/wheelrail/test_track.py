@@ -6,6 +6,7 @@ import pytest
 from scipy.special import fresnel
 
 from symcat.errors import ParameterError
+from symcat.wheelrail.track_pieces import TrackRailFrames
 from symcat.wheelrail.track import (
     UIC60_RAIL_OFFSET_M,
     Curve,
@@ -235,3 +236,35 @@ def test_synthetic_irregularities_follow_the_psd():
     np.testing.assert_allclose(tapered.evaluate([0.0, 200.0]), 0.0, atol=1e-15)
     with pytest.raises(ParameterError, match="level='medium'"):
         synthetic_irregularities(100.0, level="medium")
+
+
+@pytest.mark.parametrize("pivot", ["centre", "low_rail"])
+def test_smooth_cant_ramp_has_no_kinks(pivot):
+    """Bloss's cubic superelevation ``h0 + (h1 - h0)(3 x^2 - 2 x^3)``: the end values of the
+    linear ramp, half the cant mid-way, zero cant rate at both ends (so no kinks for the contact
+    driver), and frames whose derivatives match finite differences inside the ramp."""
+    segments = [Tangent(40.0), Transition(60.0, "smooth"), Curve(80.0, 300.0, "right", 0.15), Transition(70.0, "smooth"),
+                Curve(50.0, 500.0, "left", 0.10), Transition(40.0, "smooth"), Tangent(20.0)]
+    track = TrackLayout(segments, cant_pivot=pivot)
+    linear = TrackLayout([Tangent(40.0), Transition(60.0), *segments[2:3], Transition(70.0), *segments[4:5],
+                          Transition(40.0), Tangent(20.0)], cant_pivot=pivot)
+    joins = track.joins_m
+    np.testing.assert_allclose(track.superelevation(joins), linear.superelevation(joins), atol=1e-15)
+    mid = 0.5 * (joins[1] + joins[2])
+    assert track.superelevation(np.array([mid]))[0] == pytest.approx(0.075)
+    h = [track.superelevation(joins[1:-1] + d) for d in (-1e-4, 0.0, 1e-4)]
+    assert np.abs(h[2] - h[1]).max() < 1e-9 and np.abs(h[1] - h[0]).max() < 1e-9  # zero rate at the ends
+    assert len(TrackRailFrames(track, "left").kinks_m) == 0 and len(TrackRailFrames(linear, "left").kinks_m) > 0
+    s = _interior(track)
+    step = 1e-3
+    for side in ("left", None):
+        ev = track.track_frame if side is None else (lambda x: track.rail_frame(x, side))
+        f, fp, fm = ev(s), ev(s + step), ev(s - step)
+        for name, d in (("R", "dR_ds"), ("dR_ds", "d2R_ds2"), ("A", "dA_ds"), ("dA_ds", "d2A_ds2")):
+            fd = (getattr(fp, name) - getattr(fm, name)) / (2 * step)
+            exact = getattr(f, d)
+            axes = tuple(range(1, exact.ndim))
+            scale = np.maximum(np.sqrt((exact**2).sum(axis=axes)), 1e-3)
+            assert (np.sqrt(((fd - exact) ** 2).sum(axis=axes)) / scale).max() < 1e-6, (side, d)
+    with pytest.raises(ParameterError, match="cant_ramp='cubic'"):
+        TrackLayout([Tangent(10.0), Transition(10.0, "cubic"), Curve(10.0, 300.0, "left", 0.1)])

@@ -57,13 +57,15 @@ def test_a_start_off_the_lead_in_or_a_driving_constraint_in_a_curve_is_refused(p
     assert layout.track is straight
 
 
-def test_contact_frames_on_a_canted_curve_are_the_track_frames(pair):
+@pytest.mark.parametrize("ramp, atol", [("linear", 1e-9), ("smooth", 5e-8)])
+def test_contact_frames_on_a_canted_curve_are_the_track_frames(pair, ramp, atol):
     """The creep direction ``t1`` and the axes of Y and Q at contacts in a transition and in a
     canted curve: the rail tangent and the canted track frame of the layout's exact frames
-    (the kernels' are cubic pieces): the lateral axis normal to the centre line and tilted by
-    the cant angle."""
+    (the kernels' are cubic pieces of at most 1 m: exact to 1e-9 for the linear cant ramp,
+    whose cant angle is nearly linear, to 1.4e-8 for the cubic smooth ramp): the lateral axis
+    normal to the centre line and tilted by the cant angle."""
     track, _ = curve_track(pair, 300.0, cant_m=0.12, transition_length_m=20.0, curve_length_m=40.0,
-                           direction="right")
+                           direction="right", cant_ramp=ramp)
     layout = VehicleLayout(pair=pair, track=track)
     chainage = np.array([25.3, 33.9, 47.1, 60.0])
     s2r = np.array([0.035, 0.03, 0.04, 0.038])
@@ -75,13 +77,13 @@ def test_contact_frames_on_a_canted_curve_are_the_track_frames(pair):
         u = np.column_stack([np.zeros(4), sign * point[:, 0], point[:, 1]])
         du = np.column_stack([np.zeros(4), sign * slope[:, 0], slope[:, 1]])
         tangent = exact.dR_ds + np.einsum("nij,nj->ni", exact.dA_ds, u)
-        np.testing.assert_allclose(t1, tangent / np.linalg.norm(tangent, axis=1, keepdims=True), atol=1e-9)
+        np.testing.assert_allclose(t1, tangent / np.linalg.norm(tangent, axis=1, keepdims=True), atol=atol)
         normal = sign * np.cross(t1, np.einsum("nij,nj->ni", exact.A, du))
-        np.testing.assert_allclose(n, normal / np.linalg.norm(normal, axis=1, keepdims=True), atol=1e-9)
+        np.testing.assert_allclose(n, normal / np.linalg.norm(normal, axis=1, keepdims=True), atol=atol)
         frame = track.track_frame(chainage)
-        np.testing.assert_allclose(axes, frame.A, atol=1e-9)
+        np.testing.assert_allclose(axes, frame.A, atol=atol)
         phi = track.cant_angle(chainage)
-        np.testing.assert_allclose(axes[:, 2, 1], np.sin(phi), atol=1e-9)           # lateral axis tilted by the cant
+        np.testing.assert_allclose(axes[:, 2, 1], np.sin(phi), atol=atol)           # lateral axis tilted by the cant
         np.testing.assert_allclose(np.einsum("ni,ni->n", axes[:, :, 1], frame.A[:, :, 0]), 0.0, atol=1e-12)
         assert np.all(np.abs(phi[1:]) > 0.03)                                         # canted: a real test
 
@@ -183,3 +185,28 @@ def test_steady_curving_the_rails_carry_the_centripetal_force():
     y = lateral_displacement_m(res, layout)
     assert y["b1_ws1"][-1] < -2e-3 and y["b1_ws2"][-1] > 2e-3
     assert max(np.abs(v).max() for v in y.values()) < 0.02
+
+
+def test_the_vehicle_crosses_a_smooth_cant_ramp():
+    """A 100 mm cant ramped over a 10 m clothoid: with the smooth (Bloss) ramp the rails have no
+    kinks, and the vehicle's leading wheelset runs from the lead-in over the whole ramp into the
+    canted curve (with a linear ramp its rigid contacts stop at the ramp's start, an impact:
+    ``cant_ramp="linear"``). The wheels' contact forces are the vehicle's whole external force
+    besides gravity (Newton's law with the solver's accelerations, at every output), and the
+    wheels stay loaded."""
+    pair = profile_pair("conical", STEEP_CONE)
+    track, x0 = curve_track(pair, RADIUS, cant_m=0.1, transition_length_m=10.0, curve_length_m=10.0)
+    assert track.superelevation(np.array([track.joins_m[1] + 5.0]))[0] == pytest.approx(-0.05)
+    scene = Scene(gravity=(0.0, 0.0, -G))
+    layout = add_vehicle(scene, pair, speed_ms=SPEED, creep="linear", drive="torque", track=track, x_m=x0 + 1.0)
+    res = simulate(MultibodyModel(scene), 0.8, index="ggl", rtol=1e-7, n_out=16, progress=False)
+    lead = [res.wheelrail[layout.contacts[layout.wheelsets[0]][side]]["s"][:, 2] for side in ("left", "right")]
+    assert np.min(lead, axis=0)[-1] > track.joins_m[2] + 0.5  # past the ramp's end
+    forces = wheel_forces(res, layout)
+    mass = {b.name: b.mass for b in scene.rigid_bodies}
+    acc = sum(m * (res.a[:, res.coordinate_names.index(f"{b}.x"):][:, :3] - np.array([0.0, 0.0, -G]))
+              for b, m in mass.items())
+    total_force = np.sum([f["force_N"] for f in forces.values()], axis=0)
+    np.testing.assert_allclose(total_force, acc, rtol=0, atol=1e-9 * sum(mass.values()) * G)
+    normal = np.array([f["normal_N"] for f in forces.values()])
+    assert normal.min() > 0.5 * normal[:, 0].min()
