@@ -259,13 +259,13 @@ class ContactStepper:
 
     def _next_end(self, pos, end: int, k_max: int, dt: float):
         """``(end position, free)`` of the next call from ``pos`` (an integer, in units of
-        ``dt / end``, see :meth:`advance`). On the binary grid: ``dt / 2^k``, the longest not beyond the span,
-        from a multiple of it (one integrator per grid serves all such calls). A predicted jump
-        (:meth:`.contact_jumps.ContactCheck.event_s`) that binds the span is called to exactly
-        (a free call, :meth:`call`), where calls on the grid would close in on it by halves;
-        from off the grid (after such a call), a free call goes to the next multiple of the
-        level, or of the one above if that is within the span (no call shorter than a quarter
-        of it)."""
+        ``dt / end``, see :meth:`advance`). On the binary grid: ``dt / 2^k``, the longest not
+        beyond the span, from a multiple of it (one integrator per grid serves all such calls).
+        A predicted jump (:meth:`.contact_jumps.ContactCheck.event_s`) that binds the span is
+        called to exactly (a free call, :meth:`call`), where calls on the grid would close in on
+        it by halves. From off the grid (after such a call), a free call goes to the next
+        multiple of the level, or to the one after it when the first is less than a quarter
+        level away and the span allows (no needlessly short call)."""
         k = min(k_max, max(0, math.ceil(math.log2(dt / self.span)))) if self.span < dt else 0
         unit = 2 ** (k_max - k)
         if math.isfinite(self.event) and self.event <= self.span * (1 + 1e-9):
