@@ -47,6 +47,7 @@ from ..scene.rigid import RigidBody
 from ..scene.wheelrail import CreepModel, WheelRailJoint
 from ..wheelrail.creep import SHEAR_MODULUS_STEEL_PA, kalker_coefficients, kalker_linear_forces
 from ..wheelrail.hertz import hertz_contact, relative_curvatures
+from ..wheelrail.track_pieces import interval_lookup
 
 #: Rows of a contact that define its surface parameters in the embedded form (eq. 22: the two
 #: in-plane coincidence rows and the two tangency rows); row 2 is the normal gap.
@@ -95,14 +96,8 @@ def piece_lookup(profile, name: str) -> ca.Function:
     """Compiled SX lookup ``s -> [s0, y_0:4, z_0:4]`` of the cubic piece containing ``s``
     (the end pieces extend beyond the profile's ends)."""
     pp = profile.piecewise_polynomial()
-    s = ca.SX.sym("s")
-    x, n = pp.x, pp.c.shape[1]
-    out = ca.SX.zeros(9)
-    for k in range(n):
-        below = s >= x[k] if k > 0 else 1
-        above = s < x[k + 1] if k < n - 1 else 1
-        out += below * above * ca.DM(np.r_[x[k], pp.c[:, k, 0], pp.c[:, k, 1]])
-    return ca.Function(name, [s], [out])
+    rows = np.column_stack([pp.x[:-1], pp.c[:, :, 0].T, pp.c[:, :, 1].T])
+    return interval_lookup(pp.x, rows, name)
 
 
 def add_wheelrail(model, joint: WheelRailJoint) -> WheelRailEntry:

@@ -52,7 +52,7 @@ from symcat.errors import ParameterError
 
 from .irregularities import (Irregularities, _positive, erri_b176_psd, read_irregularities,  # noqa: F401
                              synthetic_irregularities)
-from .track_parts import CANT_RAMPS, Curve, FramePiece, RailFrame, Tangent, Transition, rail_offset_for  # noqa: F401
+from .track_parts import CANT_RAMPS, Curve, cant_ramp_values, FramePiece, RailFrame, Tangent, Transition, rail_offset_for  # noqa: F401
 
 #: Lateral distance from the track centre to the UIC60 1:40 profile origin for a 1.435 m gauge
 #: measured 14 mm below the rail top (:func:`rail_offset_for` with the shipped profile) [m].
@@ -255,19 +255,8 @@ class TrackLayout:
         return self._superelevation(seg, u)[0]
 
     def _superelevation(self, seg, u):
-        """``h`` [m] and its first two derivatives along the track at ``u`` [m] into segments
-        ``seg``: linear, or the smooth ramp ``3 x^2 - 2 x^3`` (:class:`Transition`)."""
-        rate = self._dh[seg]
-        h, dh, d2h = self._h0[seg] + rate * u, rate + 0.0 * u, 0.0 * u
-        smooth = self._smooth[seg]
-        if np.any(smooth):
-            length = self._L[seg][smooth]
-            x = u[smooth] / length
-            rise = rate[smooth] * length
-            h[smooth] = self._h0[seg][smooth] + rise * x * x * (3.0 - 2.0 * x)
-            dh[smooth] = rise * 6.0 * x * (1.0 - x) / length
-            d2h[smooth] = rise * (6.0 - 12.0 * x) / length**2
-        return h, dh, d2h
+        """``h`` [m] and its first two derivatives at ``u`` [m] into segments ``seg``."""
+        return cant_ramp_values(self._h0[seg], self._dh[seg], self._L[seg], self._smooth[seg], u)
 
     def cant_angle(self, s_m) -> np.ndarray:
         """Cant angle ``phi = arcsin(h / cant_base_m)`` [rad], positive lifting the left rail."""

@@ -56,6 +56,21 @@ class Transition:
     cant_ramp: str = "linear"
 
 
+def cant_ramp_values(h0, rate, length, smooth, u):
+    """Superelevation ``h`` [m] and its first two derivatives along the track at ``u`` [m] into
+    segments starting at ``h0`` and changing by ``rate * length`` over ``length`` (arrays, one
+    entry per point): linear, or where ``smooth`` the cubic ``3 x^2 - 2 x^3`` of
+    ``x = u / length`` (:class:`Transition`)."""
+    h, dh, d2h = h0 + rate * u, rate + 0.0 * u, 0.0 * u
+    if np.any(smooth):
+        x = u[smooth] / length[smooth]
+        rise = rate[smooth] * length[smooth]
+        h[smooth] = h0[smooth] + rise * x * x * (3.0 - 2.0 * x)
+        dh[smooth] = rise * 6.0 * x * (1.0 - x) / length[smooth]
+        d2h[smooth] = rise * (6.0 - 12.0 * x) / length[smooth] ** 2
+    return h, dh, d2h
+
+
 @dataclass(frozen=True)
 class RailFrame:
     """A rail profile frame and its derivatives along the track, vectorised over ``n`` points.

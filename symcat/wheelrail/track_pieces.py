@@ -58,6 +58,21 @@ def _cant_rate_steps(layout: TrackLayout) -> np.ndarray:
     return layout.joins_m[1:-1][step > 1e-12]
 
 
+def interval_lookup(breaks, rows, name: str, arg: str = "i0", out: str = "o0") -> ca.Function:
+    """SX function ``s -> rows[k]`` for ``breaks[k] <= s < breaks[k + 1]`` (the first and last
+    rows extend beyond the ends): the sum of every row times the indicator of its interval, which
+    expands to SX and compiles (its derivative is zero)."""
+    s = ca.SX.sym(arg)
+    rows = np.asarray(rows, float)
+    n = len(rows)
+    value = ca.SX.zeros(rows.shape[1])
+    for k in range(n):
+        below = s >= breaks[k] if k > 0 else 1
+        above = s < breaks[k + 1] if k < n - 1 else 1
+        value += below * above * ca.DM(rows[k])
+    return ca.Function(name, [s], [value], [arg], [out])
+
+
 def rot_x(a: float) -> np.ndarray:
     c, s = math.cos(a), math.sin(a)
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
@@ -201,14 +216,7 @@ class TrackRailFrames:
         picked (:func:`symcat.assembly.wheelrail.piece_lookup`). Its derivative is zero; unlike a
         binary search with a symbolic index (``casadi.low``), it expands to SX, so that a model
         on a track layout compiles whole (:mod:`symcat.codegen.model_dae`)."""
-        s = ca.SX.sym("s1r")
-        x, n = self.breaks_m, len(self.table)
-        out = ca.SX.zeros(self.table.shape[1])
-        for k in range(n):
-            below = s >= x[k] if k > 0 else 1
-            above = s < x[k + 1] if k < n - 1 else 1
-            out += below * above * ca.DM(self.table[k])
-        return ca.Function(name, [s], [out], ["s1r"], ["piece"])
+        return interval_lookup(self.breaks_m, self.table, name, "s1r", "piece")
 
     # ------------------------------------------------------------------ frames
     def _pieces(self, s):
