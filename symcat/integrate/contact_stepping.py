@@ -37,13 +37,26 @@ from .failure import split_state
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
-#: IDAS's first step in a call, relative to the call's length.
-INITIAL_STEP = 1e-3
+#: IDAS's first step in a call, relative to the call's length, when no earlier step suggests one
+#: (the first call, after a failure): ``2^-FIRST_STEP_LEVELS``, about 1e-3.
+FIRST_STEP_LEVELS = 10
+#: The first step of a call is IDAS's last step in the previous one, rounded down to ``2^-k``
+#: of the call with ``k`` a multiple of this (one integrator per level and grid: building one
+#: costs about 10 ms, as much as 10 steps). IDAS restarts at order 1, whose error test the
+#: last step (of order up to 5) may fail: then it shrinks the step, at a few Jacobian set-ups;
+#: a quarter of the last step measured worse (S1002 vehicle, rtol 1e-4: 1193 steps instead of
+#: 1063). After a jump the step stays: the velocities change, but not the time scales.
+FIRST_STEP_LEVEL_STEP = 3
 #: Integrators kept (one per call grid and linear solver; a long run meets many grids).
 MAX_INTEGRATORS = 64
 #: A jump target this deep at a call's end (m) means the jump came late: the call is redone
 #: shorter (:meth:`ContactStepper._late_jump`).
 LATE_JUMP_GAP_M = 1e-8
+#: A late jump's call is redone to this fraction of the estimated crossing time
+#: (:meth:`ContactStepper._late_jump`), so that the rival is found above the followed point.
+LATE_JUMP_EARLY = 0.9
+#: Least fraction of a call that a late jump's redo keeps (:meth:`ContactStepper._late_jump`).
+LATE_JUMP_MIN_FRACTION = 0.25
 #: Relaxed jumps tried after consecutive failed calls from one state.
 RELAXED_JUMPS = 3
 #: How long (s) a jump target stays refused after IDAS failed from it (see ``advance``).
@@ -103,6 +116,7 @@ class ContactStepper:
         # passed unnoticed), and the retry, shorter and after a jump check, beats waiting.
         self.opts["max_num_steps"] = min(int(opts.get("max_num_steps", MAX_CALL_STEPS)), MAX_CALL_STEPS)
         self.set_dae(dae_fn)
+        self.step_hint = None  # IDAS's first step in the next call (s), see _first_step_level
         self.refused: dict[str, tuple[float, float]] = {}  # contact -> (wheel parameter, until t)
         self._jumped_from = None  # (t, x, z, [(contact, new wheel parameter)]) of the last jump
         self.checks = check_contacts(form, x, z)
@@ -132,7 +146,8 @@ class ContactStepper:
             if n:
                 self.stats["contact_fallbacks"] += 1
             normalized = free and shifted
-            integ = self._integrator([v / h for v in grid] if normalized else grid, solver, shifted, normalized)
+            level = self._first_step_level(h) if shifted else 0
+            integ = self._integrator([v / h for v in grid] if normalized else grid, solver, shifted, normalized, level)
             try:
                 if shifted:
                     if x_dot is None:
@@ -148,17 +163,35 @@ class ContactStepper:
             st = integ.stats()
             for k in self.stat_keys:
                 self.stats[k] += int(st.get(k, 0))
+            last = float(st.get("hlast", math.nan)) * (h if normalized else 1.0)
+            hinted = n == 0 and self.form.index == "ggl" and math.isfinite(last) and last > 0
+            self.step_hint = last if hinted else None
             xs = np.asarray(out["xf"])
             if shifted:
                 xs = x[:, None] + np.outer(x_dot, grid) + scale[:, None] * xs
             return xs, np.asarray(out["zf"])
         raise exc
 
-    def _integrator(self, grid, solver: str, shifted: bool, normalized: bool = False):
+    def _first_step_level(self, h: float) -> int:
+        """``k`` of IDAS's first step ``h / 2^k`` in a call of length ``h`` (s): from
+        :attr:`step_hint` (IDAS's last step in the previous call, when this one continues it),
+        else :data:`FIRST_STEP_LEVELS`. Restarting from about 1e-3 of the call, IDAS takes ten
+        steps, each with a Jacobian set-up, to double its step back up: most of the steps of a
+        model with a hundred calls per simulated second. Only with GGL stabilization: index 1
+        leaves the position constraints to drift, and its first steps at order 1 and the last
+        step's size drift more (the cant-ramp wheelset: 1.05e-4 m over 0.8 s instead of
+        4.6e-5 m)."""
+        if self.step_hint is None:
+            return FIRST_STEP_LEVELS
+        k = max(0, math.ceil(math.log2(h / self.step_hint) - 1e-9))
+        return min(FIRST_STEP_LEVELS, FIRST_STEP_LEVEL_STEP * math.ceil(k / FIRST_STEP_LEVEL_STEP))
+
+    def _integrator(self, grid, solver: str, shifted: bool, normalized: bool = False, level: int = FIRST_STEP_LEVELS):
         """The integrator of the shifted DAE (or, not ``shifted``, of the DAE itself with
         IDACalcIC) on ``grid`` with ``solver``, built on first use; ``normalized``: the shifted
-        DAE in time normalized by the call's length (``grid`` in ``(0, 1]``)."""
-        key = (solver, shifted, normalized) + tuple(float(f"{v:.12e}") for v in grid)  # intervals differ in the last bits
+        DAE in time normalized by the call's length (``grid`` in ``(0, 1]``); ``level``: IDAS's
+        first step is ``2^-level`` of the call (:meth:`_first_step_level`)."""
+        key = (solver, shifted, normalized, level) + tuple(float(f"{v:.12e}") for v in grid)  # intervals differ in the last bits
         integ = self._integrators.get(key)
         if integ is None:
             if shifted:
@@ -167,7 +200,7 @@ class ContactStepper:
                 # IDAS's first step would be a thousandth of the first output time (xi_dot = 0
                 # gives it no other scale): the call's length instead, so that the steps do not
                 # depend on the outputs inside the call.
-                dae, opts = self._shifted[normalized], {**self.opts, "calc_ic": False, "step0": INITIAL_STEP * grid[-1]}
+                dae, opts = self._shifted[normalized], {**self.opts, "calc_ic": False, "step0": 2.0**-level * grid[-1]}
             else:
                 dae, opts = self.dae_fn, self.opts
             if len(self._integrators) >= MAX_INTEGRATORS:
@@ -215,11 +248,18 @@ class ContactStepper:
 
     def _late_jump(self, checks_end, h: float, t: float) -> float | None:
         """Time (s after the call's start) at which a rival sank below the followed point, if at
-        the call's end one lies deeper than :data:`LATE_JUMP_GAP_M` (linear interpolation of
-        its margin from the call's start; half the call if it was not there yet): the jump is
-        then redone at about that time. The rates' linear prediction (:meth:`ContactCheck.span_s`)
-        misses a rival that speeds up; a late jump lifts the wheelset (GGL projects onto the
-        deeper point: energy gained) or leaves it penetrating (index 1)."""
+        the call's end one lies deeper than :data:`LATE_JUMP_GAP_M`: the jump is then redone at
+        about that time. The rates' linear prediction (:meth:`ContactCheck.span_s`) misses a
+        rival that speeds up or is born inside the call; a late jump lifts the wheelset (GGL
+        projects onto the deeper point: energy gained) or leaves it penetrating (index 1).
+
+        The time is the secant zero of the rival's margin between the call's ends if a rival
+        lay above the followed point at the start (the nearest along the wheel), else the
+        margin's zero extrapolated back from its end rate (a rival born inside the call), else
+        half the call; at least :data:`LATE_JUMP_MIN_FRACTION` of it, so that the redone calls
+        close in geometrically where the estimate fails (at a rail's kink the point past the
+        crease appears with the crossing: an estimate near the start would advance the run by
+        microseconds per call)."""
         refused = {name: s1 for name, (s1, until) in self.refused.items() if t + h < until}
         first = None
         for start, end in zip(self.checks, checks_end):
@@ -227,9 +267,14 @@ class ContactStepper:
             if rival is None or rival.point.gap_m >= -LATE_JUMP_GAP_M:
                 continue
             m1 = end.margin_m(rival)
-            formed = [start.margin_m(r) for r in start.rivals if r.formed]
-            m0 = min(formed) if formed else None
-            f = m0 / (m0 - m1) if m0 is not None and m0 > 0 > m1 else 0.5
+            before = [r for r in start.rivals if start.margin_m(r) > 0]
+            f = 0.5
+            if before:
+                m0 = start.margin_m(min(before, key=lambda r: abs(r.point.s[0] - rival.point.s[0])))
+                f = m0 / (m0 - m1)
+            elif rival.gap_rate_m_s < end.gap_rate_m_s:
+                f = max(0.0, 1.0 + m1 / ((end.gap_rate_m_s - rival.gap_rate_m_s) * h))
+            f = min(max(f, LATE_JUMP_MIN_FRACTION), 1.0)
             first = f * h if first is None else min(first, f * h)
         return first
 
@@ -322,6 +367,7 @@ class ContactStepper:
             try:
                 xs_new, zs_new = self.call(x, z, t, h, [times[j] - t for j in inside], free)
             except RuntimeError as exc:
+                self.step_hint = None
                 self.stats["contact_retries"] += 1
                 failures += 1
                 if t - stall_t > STALL_SPAN_S:
@@ -361,7 +407,8 @@ class ContactStepper:
                 if t_late is not None:
                     # A rival sank below the followed point unpredicted: redo up to before it.
                     self.stats["jump_redos"] += 1
-                    self.span, self.event = max(0.9 * t_late, MIN_SPAN_S), math.inf
+                    # A free call to just before it (the rival, then above, is predicted).
+                    self.span = self.event = max(LATE_JUMP_EARLY * t_late, MIN_SPAN_S)
                     continue
             pos = pos_b
             for col, j in enumerate(inside):

@@ -1,0 +1,56 @@
+"""The contact driver's choices between calls (:class:`symcat.integrate.contact_stepping.ContactStepper`):
+IDAS's first step in a call that continues the last one, and the time a late jump is redone at."""
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from symcat.integrate.contact_jumps import ContactCheck, Rival
+from symcat.integrate.contact_stepping import FIRST_STEP_LEVEL_STEP, FIRST_STEP_LEVELS, ContactStepper
+
+
+def _stepper(hint=None, checks=()):
+    stepper = object.__new__(ContactStepper)  # the choices need no model
+    stepper.step_hint, stepper.checks, stepper.refused = hint, list(checks), {}
+    return stepper
+
+
+@pytest.mark.parametrize("hint, level", [(None, FIRST_STEP_LEVELS), (1.0, 0), (2.0, 0), (0.5, FIRST_STEP_LEVEL_STEP),
+                                         (1 / 9, 2 * FIRST_STEP_LEVEL_STEP), (1e-9, FIRST_STEP_LEVELS)])
+def test_first_step_is_the_last_one_rounded_down_to_a_level(hint, level):
+    """IDAS's first step ``h / 2^k``: the previous call's last step rounded down to a level
+    (never above it, never above the call), the default without one."""
+    h = 1e-2
+    k = _stepper(None if hint is None else hint * h)._first_step_level(h)
+    assert k == level
+    if hint is not None and k < FIRST_STEP_LEVELS:
+        assert h / 2**k <= min(hint, 1.0) * h * (1 + 1e-12)
+
+
+def _check(gap_rate=0.0, rivals=()):
+    return ContactCheck("w", 0.0, gap_rate, 1.0, math.inf, np.zeros(4), list(rivals))
+
+
+def _rival(s1, gap, rate=0.0):
+    return Rival(SimpleNamespace(s=np.array([s1, 0.0, 0.0, 0.0]), gap_m=gap), 1.0, rate)
+
+
+def test_a_late_jump_is_redone_at_the_secant_zero_of_the_margin():
+    """A rival 3 um above at the start and 1 um below at the end crossed at 3/4 of the call;
+    the nearest rival along the wheel is the one followed, not the lowest."""
+    start = _check(rivals=[_rival(0.030, 0.5e-6), _rival(0.001, 3e-6)])
+    end = _check(rivals=[_rival(0.0012, -1e-6)])
+    assert _stepper(checks=[start])._late_jump([end], 2e-3, 0.0) == pytest.approx(0.75 * 2e-3)
+
+
+def test_a_rival_born_inside_a_call_is_traced_back_along_its_rate():
+    """No rival at the start: the crossing is extrapolated back from the end's margin rate
+    (1 um below, closing at 1 mm/s: 1 ms before the end); without a closing rate, half."""
+    end = _check(gap_rate=0.0, rivals=[_rival(0.001, -1e-6, rate=-1e-3)])
+    assert _stepper(checks=[_check()])._late_jump([end], 4e-3, 0.0) == pytest.approx(3e-3)
+    level = _check(gap_rate=0.0, rivals=[_rival(0.001, -1e-6, rate=0.0)])
+    assert _stepper(checks=[_check()])._late_jump([level], 4e-3, 0.0) == pytest.approx(2e-3)
+    # A rival only nanometres below is no late jump (the next check jumps to it).
+    shallow = _check(rivals=[_rival(0.001, -1e-9, rate=-1e-3)])
+    assert _stepper(checks=[_check()])._late_jump([shallow], 4e-3, 0.0) is None
