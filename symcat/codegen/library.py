@@ -127,10 +127,13 @@ class BufferedFunction:
             self._buffer.set_arg(i, memoryview(a))
         for i, a in enumerate(self._outputs):
             self._buffer.set_res(i, memoryview(a))
+        # Per output: its shape and the row-major positions of its nonzeros (CasADi's are
+        # column-major): one 1-D scatter per call.
         self._patterns = []
         for i in range(function.n_out()):
             sp = function.sparsity_out(i)
-            self._patterns.append((sp.shape, np.array(sp.row(), int), np.array(sp.get_col(), int)))
+            flat = np.array(sp.row(), int) * sp.shape[1] + np.array(sp.get_col(), int)
+            self._patterns.append((sp.shape, sp.shape[0] * sp.shape[1], flat))
 
     def __call__(self, *args) -> list[np.ndarray]:
         """Dense outputs (new arrays, shaped as the Function's) at the inputs ``args``.
@@ -147,10 +150,10 @@ class BufferedFunction:
             self.function(*args)  # raises CasADi's own error
             raise RuntimeError(f"{self.function.name()}: evaluation failed")
         out = []
-        for nz, (shape, rows, cols) in zip(self._outputs, self._patterns):
-            dense = np.zeros(shape)
-            dense[rows, cols] = nz
-            out.append(dense)
+        for nz, (shape, size, flat) in zip(self._outputs, self._patterns):
+            dense = np.zeros(size)
+            dense[flat] = nz
+            out.append(dense.reshape(shape))
         return out
 
 

@@ -33,6 +33,8 @@ class ContactPoint:
         Newton iterations.
     contact : symcat.wheelrail.constraint_contact.WheelRailContact
         The contact solved (it describes the point).
+    kernels : ContactKernels or None
+        The contact's kernels at ``s`` (with ``clip``), as the solve's last evaluation left them.
     rolling_radius_m : float
         Wheel radius at the contact point [m].
     contact_angle_rad : float
@@ -51,6 +53,7 @@ class ContactPoint:
     residual: float
     iterations: int
     contact: object = field(repr=False, compare=False)
+    kernels: object = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         self._solved_s = np.array(self.s, float)  # described as solved, whatever becomes of s
