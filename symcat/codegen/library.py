@@ -103,6 +103,18 @@ class KernelLibrary:
         return f
 
 
+def fused(functions) -> ca.Function:
+    """One Function of the same inputs giving the outputs of all ``functions`` in order (they
+    share their inputs): one call from Python instead of several. A single one is returned as
+    it is."""
+    if len(functions) == 1:
+        return functions[0]
+    first = functions[0]
+    args = [ca.MX.sym(first.name_in(i), first.sparsity_in(i)) for i in range(first.n_in())]
+    outputs = [out for f in functions for out in f.call(args)]
+    return ca.Function("_".join(f.name() for f in functions), args, outputs)
+
+
 class BufferedFunction:
     """A CasADi Function evaluated in preallocated numpy arrays: a call of a small kernel from
     Python costs 0.2 us instead of about 30 us (no conversion of the inputs to ``DM`` and of

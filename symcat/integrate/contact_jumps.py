@@ -45,7 +45,7 @@ from ..assembly.wheelrail import GAP_ROW, TANGENCY_ROWS
 from ..dae.formulation import normal_forces_numeric
 from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
-from ..wheelrail.constraint_contact import solve_small
+from ..wheelrail.contact_point import solve_small
 from ..wheelrail.gap_minima import gap_minima_batch
 from .failure import physical_coordinates, restart_point, split_state
 

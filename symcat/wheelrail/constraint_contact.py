@@ -29,11 +29,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg.lapack import dgesv as _dgesv
 
 from symcat.errors import ParameterError, SolverError
 
-from .contact_point import ContactPoint
+from .contact_point import ContactPoint, solve_small
 from .geometry import TrackCrossSection, WheelsetDimensions
 from .profiles import Profile
 from .track_pieces import rail_frames
@@ -44,21 +43,6 @@ N_PARAMS = 24  # tangent track; curved track adds the 22 parameters of a track p
 #: Largest Newton step per surface parameter: s1w, s2w, s1r, s2r [m, rad, m, m].
 MAX_STEP = np.array([2e-3, 0.02, 5e-3, 2e-3])
 _CONDITION_ROWS = np.array([0, 1, 3, 4])  # rail-frame form: all rows but the gap
-
-
-def solve_small(a, b) -> np.ndarray:
-    """``np.linalg.solve(a, b)`` of a small system without its overhead (LAPACK's ``dgesv``
-    directly, 1 us instead of 5: the same result bit for bit).
-
-    Raises
-    ------
-    numpy.linalg.LinAlgError
-        If ``a`` is singular.
-    """
-    _, _, x, info = _dgesv(a, b)
-    if info > 0:
-        raise np.linalg.LinAlgError("Singular matrix")
-    return x
 
 
 def library_name(form: str, track: str = "ground") -> str:
@@ -184,9 +168,10 @@ class WheelRailContact:
         it owns its buffers)."""
         f = self._buffered.get(suffix)
         if f is None:
-            from symcat.codegen.library import BufferedFunction
+            from symcat.codegen.library import BufferedFunction, fused
 
-            f = self._buffered[suffix] = BufferedFunction(self.kernels[f"{self.library}_{suffix}"])
+            names = [f"{self.library}_{part}" for part in suffix.split("_")]  # "c_jac": one call for both
+            f = self._buffered[suffix] = BufferedFunction(fused([self.kernels[n] for n in names]))
         return f
 
     @staticmethod
@@ -255,8 +240,8 @@ class WheelRailContact:
             raise ParameterError(f"q, s: shapes {q.shape}, {s.shape}; must be (7,) and (4,)")
         y = np.concatenate((q, s))
         p = self._parameters(s, **kw)
-        c = self._kernel("c")(y, t, p)[0].ravel()
-        c_y, c_t = self._kernel("jac")(y, t, p)
+        c, c_y, c_t = self._kernel("c_jac")(y, t, p)
+        c = c.ravel()
         q_d = None
         if q_dot is not None or s_dot is not None:
             y_dot = np.r_[np.zeros(7) if q_dot is None else q_dot, np.zeros(4) if s_dot is None else s_dot]
