@@ -12,13 +12,14 @@ contact point would have to move infinitely fast). IDAS cannot pass a fold: it s
 Jacobian).
 
 So the driver (:mod:`.contact_stepping`) integrates in short calls and, after each, looks at
-every wheel from scratch (:meth:`WheelRailContact.local_minima`). The contact jumps to the lowest
-other minimum that is *formed* (relative curvature at least :data:`FOLD_CURVATURE_PER_M`; a
-newborn minimum has none and may vanish again) once that lies :data:`JUMP_TOLERANCE_M` below the
-followed point (the hysteresis against chattering between twin minima), or to any lower one when
-the followed point nears its fold (``kappa`` below that) or IDAS has failed. The surface
-parameters move there and the velocities are projected onto the constraints (the minimum-norm
-change: a plastic impact at the new point) before IDAS restarts; the positions stay as they are.
+every wheel from scratch (:func:`symcat.wheelrail.gap_minima.gap_minima_batch`, all wheels at
+once). The contact jumps to the lowest other minimum that is *formed* (relative curvature at
+least :data:`FOLD_CURVATURE_PER_M`; a newborn minimum has none and may vanish again) once that
+lies :data:`JUMP_TOLERANCE_M` below the followed point (the hysteresis against chattering
+between twin minima), or to any lower one when the followed point nears its fold (``kappa``
+below that) or IDAS has failed. The surface parameters move there and the velocities are
+projected onto the constraints (the minimum-norm change: a plastic impact at the new point)
+before IDAS restarts; the positions stay as they are.
 
 A call lasts at most until (a) the followed point has travelled :data:`TRAVEL_M` along the wheel
 profile, (b) about half the time until its relative curvature has halved (predicted from the
