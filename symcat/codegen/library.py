@@ -103,6 +103,18 @@ class KernelLibrary:
         return f
 
 
+def fused(functions) -> ca.Function:
+    """One Function of the same inputs giving the outputs of all ``functions`` in order (they
+    share their inputs): one call from Python instead of several. A single one is returned as
+    it is."""
+    if len(functions) == 1:
+        return functions[0]
+    first = functions[0]
+    args = [ca.MX.sym(first.name_in(i), first.sparsity_in(i)) for i in range(first.n_in())]
+    outputs = [out for f in functions for out in f.call(args)]
+    return ca.Function("_".join(f.name() for f in functions), args, outputs)
+
+
 class BufferedFunction:
     """A CasADi Function evaluated in preallocated numpy arrays: a call of a small kernel from
     Python costs 0.2 us instead of about 30 us (no conversion of the inputs to ``DM`` and of
@@ -127,10 +139,13 @@ class BufferedFunction:
             self._buffer.set_arg(i, memoryview(a))
         for i, a in enumerate(self._outputs):
             self._buffer.set_res(i, memoryview(a))
+        # Per output: its shape and the row-major positions of its nonzeros (CasADi's are
+        # column-major): one 1-D scatter per call.
         self._patterns = []
         for i in range(function.n_out()):
             sp = function.sparsity_out(i)
-            self._patterns.append((sp.shape, np.array(sp.row(), int), np.array(sp.get_col(), int)))
+            flat = np.array(sp.row(), int) * sp.shape[1] + np.array(sp.get_col(), int)
+            self._patterns.append((sp.shape, sp.shape[0] * sp.shape[1], flat))
 
     def __call__(self, *args) -> list[np.ndarray]:
         """Dense outputs (new arrays, shaped as the Function's) at the inputs ``args``.
@@ -147,10 +162,10 @@ class BufferedFunction:
             self.function(*args)  # raises CasADi's own error
             raise RuntimeError(f"{self.function.name()}: evaluation failed")
         out = []
-        for nz, (shape, rows, cols) in zip(self._outputs, self._patterns):
-            dense = np.zeros(shape)
-            dense[rows, cols] = nz
-            out.append(dense)
+        for nz, (shape, size, flat) in zip(self._outputs, self._patterns):
+            dense = np.zeros(size)
+            dense[flat] = nz
+            out.append(dense.reshape(shape))
         return out
 
 

@@ -12,13 +12,14 @@ contact point would have to move infinitely fast). IDAS cannot pass a fold: it s
 Jacobian).
 
 So the driver (:mod:`.contact_stepping`) integrates in short calls and, after each, looks at
-every wheel from scratch (:meth:`WheelRailContact.local_minima`). The contact jumps to the lowest
-other minimum that is *formed* (relative curvature at least :data:`FOLD_CURVATURE_PER_M`; a
-newborn minimum has none and may vanish again) once that lies :data:`JUMP_TOLERANCE_M` below the
-followed point (the hysteresis against chattering between twin minima), or to any lower one when
-the followed point nears its fold (``kappa`` below that) or IDAS has failed. The surface
-parameters move there and the velocities are projected onto the constraints (the minimum-norm
-change: a plastic impact at the new point) before IDAS restarts; the positions stay as they are.
+every wheel from scratch (:func:`symcat.wheelrail.gap_minima.gap_minima_batch`, all wheels at
+once). The contact jumps to the lowest other minimum that is *formed* (relative curvature at
+least :data:`FOLD_CURVATURE_PER_M`; a newborn minimum has none and may vanish again) once that
+lies :data:`JUMP_TOLERANCE_M` below the followed point (the hysteresis against chattering
+between twin minima), or to any lower one when the followed point nears its fold (``kappa``
+below that) or IDAS has failed. The surface parameters move there and the velocities are
+projected onto the constraints (the minimum-norm change: a plastic impact at the new point)
+before IDAS restarts; the positions stay as they are.
 
 A call lasts at most until (a) the followed point has travelled :data:`TRAVEL_M` along the wheel
 profile, (b) about half the time until its relative curvature has halved (predicted from the
@@ -45,6 +46,8 @@ from ..assembly.wheelrail import GAP_ROW, TANGENCY_ROWS
 from ..dae.formulation import normal_forces_numeric
 from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
+from ..wheelrail.contact_point import solve_small
+from ..wheelrail.gap_minima import gap_minima_batch
 from .failure import physical_coordinates, restart_point, split_state
 
 #: A minimum this much below the followed point (m) triggers a jump.
@@ -70,6 +73,9 @@ KINK_TRAVEL_M = 5e-4
 GGL_PROJECT_GAP_M = 1e-8
 #: Shortest integrator call (s): the floor of the predicted spans and of retries after a failure.
 MIN_SPAN_S = 1e-6
+
+_TANGENCY = np.array(TANGENCY_ROWS)
+_HELD = np.array([0, 1, 4])  # rows held in relative_curvature (all but the wheel's tangency and the gap)
 
 
 @dataclass
@@ -187,9 +193,8 @@ def relative_curvature(contact, q, s, kernels=None) -> float:
     ``kernels``: :meth:`evaluate`'s at ``(q, s)``, if at hand."""
     k = contact.evaluate(q, s, clip=True) if kernels is None else kernels
     t = k.C_s
-    rows, cols = [0, 1, 4], [1, 2, 3]
-    reduced = t[3, 0] - t[3, cols] @ np.linalg.solve(t[rows][:, cols], t[rows, 0])
-    return float(reduced / np.hypot(*contact.wheel.derivative(s[0])))
+    reduced = t[3, 0] - t[3, 1:] @ solve_small(t[_HELD][:, 1:], t[_HELD, 0])
+    return float(reduced / math.hypot(*contact.wheel.cubic.at(float(s[0]), 1)))
 
 
 def halving_time(contact, s, s_rate, kappa: float, samples: int = 64) -> float:
@@ -199,19 +204,47 @@ def halving_time(contact, s, s_rate, kappa: float, samples: int = 64) -> float:
     as :func:`relative_curvature` on tangent track): measured profiles have their curvature
     changing over fractions of a millimetre, which a rate at the point cannot see. ``inf`` if
     it does not within that travel."""
-    if kappa <= 0 or s_rate[0] == 0:
-        return math.inf
-    tau = np.linspace(0.0, TRAVEL_M / abs(s_rate[0]), samples + 1)[1:]
-    w = np.clip(s[0] + s_rate[0] * tau, contact.wheel.s_min, contact.wheel.s_max)
-    r = np.clip(s[3] + s_rate[3] * tau, contact.rail.s_min, contact.rail.s_max)
-    # One evaluation per profile: the point's own curvature first, then the path's.
-    k_w = contact.wheel.curvature(np.concatenate(([s[0]], w)))
-    k_r = contact.rail.curvature(np.concatenate(([s[3]], r)))
-    path = -(k_w[1:] + k_r[1:])
+    return halving_times([contact], [s], [s_rate], [kappa], samples)[0]
+
+
+def halving_times(contacts, ss, s_rates, kappas, samples: int = 64) -> list[float]:
+    """:func:`halving_time` of several contact points (``contacts`` at surface parameters ``ss``
+    moving at ``s_rates``, relative curvatures ``kappas``), one curvature evaluation per
+    profile for all."""
+    out = [math.inf] * len(contacts)
+    live = [j for j, (rate, kappa) in enumerate(zip(s_rates, kappas)) if kappa > 0 and rate[0] != 0]
+    if not live:
+        return out
+    s = np.array([ss[j] for j in live], float)
+    rate = np.array([s_rates[j] for j in live], float)
+    kappa = np.array([kappas[j] for j in live], float)
+    wheels, rails = [contacts[j].wheel for j in live], [contacts[j].rail for j in live]
+    span = TRAVEL_M / np.abs(rate[:, 0])
+    tau = np.arange(samples + 1) * (span / samples)[:, None]  # np.linspace(0, span, samples + 1)
+    tau[:, -1] = span
+    tau = tau[:, 1:]
+    # The point's own curvature first, then the path's.
+    k_w = _curvatures(wheels, s[:, :1], s[:, :1] + rate[:, :1] * tau)
+    k_r = _curvatures(rails, s[:, 3:], s[:, 3:] + rate[:, 3:] * tau)
+    path = -(k_w[:, 1:] + k_r[:, 1:])
     # The path's curvatures are relative to the point's own (3D effects: roll, yaw).
-    path += kappa + (k_w[0] + k_r[0])
-    low = np.flatnonzero(path <= max(0.5 * kappa, FOLD_CURVATURE_PER_M))
-    return float(tau[low[0]]) if low.size else math.inf
+    path += (kappa + (k_w[:, 0] + k_r[:, 0]))[:, None]
+    low = path <= np.maximum(0.5 * kappa, FOLD_CURVATURE_PER_M)[:, None]
+    first = np.argmax(low, axis=1)
+    for row, j in enumerate(live):
+        if low[row, first[row]]:
+            out[j] = float(tau[row, first[row]])
+    return out
+
+
+def _curvatures(profiles, own, path) -> np.ndarray:
+    """Curvatures of ``profiles`` (one per row) at ``[own, path]``, ``path`` clipped to each
+    profile: one evaluation per distinct profile."""
+    lo, hi = np.array([[p.s_min, p.s_max] for p in profiles]).T
+    s = np.concatenate((own, np.minimum(np.maximum(path, lo[:, None]), hi[:, None])), axis=1)  # np.clip, faster
+    if all(p is profiles[0] for p in profiles):
+        return profiles[0].cubic.curvature(s)
+    return np.array([p.cubic.curvature(row) for p, row in zip(profiles, s)])
 
 
 def travel_limit(frames) -> float:
@@ -225,64 +258,77 @@ def check_contacts(form, x, z) -> list[ContactCheck]:
     model = form.model
     parts = split_state(form, x, z)
     q_full, v_full = physical_coordinates(form, parts)
-    out = []
+    out, wheels = [], []
     for e in model.wheelrail:
         q, q_dot = q_full[e.rows], v_full[e.rows]
         s = parts["s"][e.s_index : e.s_index + 4]
         k = e.contact.evaluate(q, s, clip=True)
-        tr = list(TANGENCY_ROWS)
-        s_rate = -np.linalg.solve(k.C_s[tr], k.C_q[tr] @ q_dot)
+        # The rates and the followed point's first Newton step (_own_point): one factorization.
+        both = solve_small(k.C_s[_TANGENCY], np.column_stack((k.C_q[_TANGENCY] @ q_dot, k.c[_TANGENCY])))
+        s_rate = -both[:, 0]
         gap = e.contact.gap(q, s, kernels=k)
         kappa = relative_curvature(e.contact, q, s, k)
-        check = ContactCheck(e.joint.name, gap, float(k.C_q[GAP_ROW] @ q_dot + k.C_s[GAP_ROW] @ s_rate), kappa,
-                             halving_time(e.contact, s, s_rate, kappa), s_rate,
-                             travel_m=travel_limit(e.contact.frames))
-        own = _own_point(e.contact, q, s, k)
-        for p in _minima(e.contact, q, s, gap * k.C_q[GAP_ROW, :3], own):
+        out.append(ContactCheck(e.joint.name, gap, float(k.C_q[GAP_ROW] @ q_dot + k.C_s[GAP_ROW] @ s_rate), kappa,
+                                math.inf, s_rate, travel_m=travel_limit(e.contact.frames)))
+        wheels.append((e.contact, q, q_dot, s, gap * k.C_q[GAP_ROW, :3], _own_point(e.contact, q, s, abs(both[0, 1]))))
+    contacts = [w[0] for w in wheels]
+    for check, fold in zip(out, halving_times(contacts, [w[3] for w in wheels], [c.s_rate for c in out],
+                                               [c.curvature_per_m for c in out])):
+        check.fold_in_s = fold
+    # The other minima of all wheels in one search (its phases vectorised over the wheels).
+    found = _minima(contacts, *([w[i] for w in wheels] for i in (1, 3, 4, 5))) if wheels else []
+    for check, (contact, q, q_dot, s, _, own), points in zip(out, wheels, found):
+        for p in points:
             if own is None or abs(p.s[0] - own) > SAME_POINT_M:
-                k_p = e.contact.evaluate(q, p.s, clip=True)
-                check.rivals.append(Rival(p, relative_curvature(e.contact, q, p.s, k_p),
-                                          float(k_p.C_q[GAP_ROW] @ q_dot)))
-        out.append(check)
+                k_p = p.kernels  # Newton's last evaluation, at p.s
+                check.rivals.append(Rival(p, relative_curvature(contact, q, p.s, k_p), float(k_p.C_q[GAP_ROW] @ q_dot)))
     return out
 
 
-def _minima(contact, q, s, offset, own=None) -> list:
-    """Local minima of the gap at ``q`` (lowest first), searched for with the wheelset moved by
-    ``-offset`` (the followed point's gap along the rail normal) onto the rail: the vertical
-    clearances of the search differ from normal gaps by ``gap * tan(angle) * d(angle)``, which
-    with micrometres of constraint drift shifts or erases the minima of a flat valley (tenths of
-    a millimetre apart, nanometres deep). Each is then refined at ``q`` itself. ``own``: the
-    followed point's own wheel parameter (:func:`_own_point`), already solved for: the search's
-    minimum at it is neither refined nor returned."""
-    q_touch = np.array(q, float)
-    q_touch[:3] -= offset
-    try:
-        found = contact.local_minima(q_touch, near=s[0], known=own)
-    except SolverError:
-        return []
+def _minima(contacts, qs, ss, offsets, owns) -> list[list]:
+    """Local minima of the gap of each wheel (``contacts`` at ``qs``; lowest first), searched
+    for with the wheelset moved by ``-offset`` (the followed point's gap along the rail normal)
+    onto the rail: the vertical clearances of the search differ from normal gaps by ``gap *
+    tan(angle) * d(angle)``, which with micrometres of constraint drift shifts or erases the
+    minima of a flat valley (tenths of a millimetre apart, nanometres deep). Each is then
+    refined at ``q`` itself. ``owns``: the followed points' own wheel parameters
+    (:func:`_own_point`, at ``ss``), already solved for: the search's minimum at one is neither
+    refined nor returned. A wheel off its rail has none."""
+    touch = []
+    for q, offset in zip(qs, offsets):
+        q_touch = np.array(q, float)
+        q_touch[:3] -= offset
+        touch.append(q_touch)
+    found = gap_minima_batch(contacts, touch, nears=[s[0] for s in ss], knowns=list(owns))
     out = []
-    for p in found:
-        try:
-            p = contact.solve(q, p.s, local=True)
-        except (SolverError, ParameterError):
+    for contact, q, points in zip(contacts, qs, found):
+        if isinstance(points, SolverError):
+            out.append([])
             continue
-        if all(abs(p.s[0] - o.s[0]) > SAME_POINT_M for o in out):
-            out.append(p)
-    return sorted(out, key=lambda p: p.gap_m)
+        if isinstance(points, Exception):
+            raise points
+        refined = []
+        for p in points:
+            try:
+                p = contact.solve(q, p.s, local=True)
+            except (SolverError, ParameterError):
+                continue
+            if all(abs(p.s[0] - o.s[0]) > SAME_POINT_M for o in refined):
+                refined.append(p)
+        out.append(sorted(refined, key=lambda p: p.gap_m))
+    return out
 
 
-def _own_point(contact, q, s, kernels) -> float | None:
+def _own_point(contact, q, s, predicted: float) -> float | None:
     """Wheel parameter (m) of the followed point's own exact stationary point: the followed
     parameters ``s`` are off it by the constraint drift (over the relative curvature). Newton
     from ``s`` finds it, unless it has vanished (past a fold): then Newton goes farther than
-    twice its first step predicts (perhaps to the next minimum), and there is none (None). Near
-    a fold that prediction is large: at most :data:`OWN_RADIUS_M` (beyond, the own point shows
-    up as a rival, and a jump there only corrects the parameters' drift)."""
+    twice its first step predicts (``predicted``, m, along the wheel; perhaps to the next
+    minimum), and there is none (None). Near a fold that prediction is large: at most
+    :data:`OWN_RADIUS_M` (beyond, the own point shows up as a rival, and a jump there only
+    corrects the parameters' drift)."""
     start = np.array(s, float)
     start[1] = math.remainder(start[1], 2 * math.pi)
-    tr = list(TANGENCY_ROWS)
-    predicted = abs(np.linalg.solve(kernels.C_s[tr], kernels.c[tr])[0])
     try:
         own = contact.solve(q, start, local=True).s[0]
     except (SolverError, ParameterError):

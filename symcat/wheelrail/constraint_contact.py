@@ -32,7 +32,7 @@ import numpy as np
 
 from symcat.errors import ParameterError, SolverError
 
-from .contact_point import ContactPoint
+from .contact_point import ContactPoint, solve_small
 from .geometry import TrackCrossSection, WheelsetDimensions
 from .profiles import Profile
 from .track_pieces import rail_frames
@@ -42,6 +42,7 @@ FORMS = ("global", "railframe")
 N_PARAMS = 24  # tangent track; curved track adds the 22 parameters of a track piece
 #: Largest Newton step per surface parameter: s1w, s2w, s1r, s2r [m, rad, m, m].
 MAX_STEP = np.array([2e-3, 0.02, 5e-3, 2e-3])
+_CONDITION_ROWS = np.array([0, 1, 3, 4])  # rail-frame form: all rows but the gap
 
 
 def library_name(form: str, track: str = "ground") -> str:
@@ -147,6 +148,11 @@ class WheelRailContact:
         self._wheel_rows, self._rail_rows = _piece_rows(self._wpp), _piece_rows(self._rpp)
         self._kernels = None
         self._buffered = {}
+        # Newton's bounds on the surface parameters, and (tangent track) the kernel parameters
+        # of each pair of profile pieces met so far.
+        self._lo = np.array([wheel.s_min, -math.pi, -np.inf, rail.s_min])
+        self._hi = np.array([wheel.s_max, math.pi, np.inf, rail.s_max])
+        self._param_rows = {} if not self.curved else None
 
     # ------------------------------------------------------------------ kernels
     @property
@@ -162,9 +168,10 @@ class WheelRailContact:
         it owns its buffers)."""
         f = self._buffered.get(suffix)
         if f is None:
-            from symcat.codegen.library import BufferedFunction
+            from symcat.codegen.library import BufferedFunction, fused
 
-            f = self._buffered[suffix] = BufferedFunction(self.kernels[f"{self.library}_{suffix}"])
+            names = [f"{self.library}_{part}" for part in suffix.split("_")]  # "c_jac": one call for both
+            f = self._buffered[suffix] = BufferedFunction(fused([self.kernels[n] for n in names]))
         return f
 
     @staticmethod
@@ -192,18 +199,30 @@ class WheelRailContact:
         ParameterError
             If a parameter leaves its profile or the track (unless ``clip``: end pieces extend them).
         """
+        return np.array(self._parameters(s, pieces, clip))
+
+    def _parameters(self, s, pieces=None, clip: bool = False) -> np.ndarray:
+        """:meth:`parameters`, on tangent track a read-only array shared by the calls that meet
+        the same profile pieces (the kernels copy their inputs)."""
         s = np.asarray(s, float)
         if pieces is None:
             iw = self._piece(self._wx, s[0], "s1w", self.wheel, clip)
             ir = self._piece(self._rx, s[3], "s2r", self.rail, clip)
         else:
             iw, ir = pieces
-        return np.concatenate((self._head, self._wheel_rows[iw], self._rail_rows[ir], self.frames.params(s[2], clip)))
+        if self._param_rows is None:
+            track = self.frames.params(s[2], clip)
+            return np.concatenate((self._head, self._wheel_rows[iw], self._rail_rows[ir], track))
+        row = self._param_rows.get((iw, ir))
+        if row is None:
+            row = self._param_rows[iw, ir] = np.concatenate((self._head, self._wheel_rows[iw], self._rail_rows[ir]))
+            row.flags.writeable = False
+        return row
 
     def residual(self, q, s, t: float = 0.0, **kw) -> np.ndarray:
         """The five constraints ``C(q, s)``."""
         y = np.concatenate((np.asarray(q, float), np.asarray(s, float)))
-        return self._kernel("c")(y, t, self.parameters(s, **kw))[0].ravel()
+        return self._kernel("c")(y, t, self._parameters(s, **kw))[0].ravel()
 
     def gap(self, q, s, kernels=None) -> float:
         """Normal gap (m) at surface parameters ``s`` as they are (no solve): the gap row of
@@ -220,9 +239,9 @@ class WheelRailContact:
         if q.shape != (7,) or s.shape != (4,):
             raise ParameterError(f"q, s: shapes {q.shape}, {s.shape}; must be (7,) and (4,)")
         y = np.concatenate((q, s))
-        p = self.parameters(s, **kw)
-        c = self._kernel("c")(y, t, p)[0].ravel()
-        c_y, c_t = self._kernel("jac")(y, t, p)
+        p = self._parameters(s, **kw)
+        c, c_y, c_t = self._kernel("c_jac")(y, t, p)
+        c = c.ravel()
         q_d = None
         if q_dot is not None or s_dot is not None:
             y_dot = np.r_[np.zeros(7) if q_dot is None else q_dot, np.zeros(4) if s_dot is None else s_dot]
@@ -317,56 +336,59 @@ class WheelRailContact:
         return self._newton(q, self.initial_guess(q), tol, max_iter)
 
     def _newton(self, q, s, tol, max_iter) -> ContactPoint:
-        lo = np.array([self.wheel.s_min, -math.pi, -np.inf, self.rail.s_min])
-        hi = np.array([self.wheel.s_max, math.pi, np.inf, self.rail.s_max])
-        x = np.append(s, 0.0)  # surface parameters and (global form) the gap
+        lo, hi = self._lo, self._hi
+        x = np.concatenate((s, [0.0]))  # surface parameters and (global form) the gap
         f, jac, k = self._conditions(q, x)
         res = float(np.abs(f).max())
-        for it in range(1, max_iter + 1):
-            try:
-                step = -np.linalg.solve(jac, f)
-            except np.linalg.LinAlgError:
-                raise SolverError(f"{self.side} wheel: singular contact Jacobian C_s at s={x[:4]} (the wheel "
-                                  "and rail tangent planes cannot be matched there)") from None
-            if step.size == 4:
-                step = np.append(step, 0.0)
-            scale = min(1.0, float(np.min(MAX_STEP / np.maximum(np.abs(step[:4]), 1e-300))))
-            # Backtracking on |f|: Newton on the stationarity conditions may overshoot where the
-            # profiles are nearly conformal.
-            alpha = scale
-            for _ in range(12):
-                x_new = np.append(np.clip(x[:4] + alpha * step[:4], lo, hi), x[4] + alpha * step[4])
-                f_new, jac_new, k_new = self._conditions(q, x_new)
-                res_new = float(np.abs(f_new).max())
-                if res_new <= (1 - 1e-4 * alpha) * res or res_new <= tol:
+        it = 0
+        # A start within tol and the bounds (a point solved at a nearby state) takes no step.
+        if res > tol or not ((x[:4] >= lo) & (x[:4] <= hi)).all():
+            for it in range(1, max_iter + 1):
+                try:
+                    step = -solve_small(jac, f)
+                except np.linalg.LinAlgError:
+                    raise SolverError(f"{self.side} wheel: singular contact Jacobian C_s at s={x[:4]} (the wheel "
+                                      "and rail tangent planes cannot be matched there)") from None
+                if step.size == 4:
+                    step = np.concatenate((step, [0.0]))
+                scale = min(1.0, float(np.min(MAX_STEP / np.maximum(np.abs(step[:4]), 1e-300))))
+                # Backtracking on |f|: Newton on the stationarity conditions may overshoot where the
+                # profiles are nearly conformal.
+                alpha = scale
+                for _ in range(12):
+                    x_new = np.concatenate((np.minimum(np.maximum(x[:4] + alpha * step[:4], lo), hi),  # np.clip, faster
+                                            [x[4] + alpha * step[4]]))
+                    f_new, jac_new, k_new = self._conditions(q, x_new)
+                    res_new = float(np.abs(f_new).max())
+                    if res_new <= (1 - 1e-4 * alpha) * res or res_new <= tol:
+                        break
+                    alpha *= 0.5
+                x, f, jac, k, res = x_new, f_new, jac_new, k_new, res_new
+                if res <= tol or (alpha == 1.0 and np.abs(step[:4]).max() < 1e-14):
                     break
-                alpha *= 0.5
-            x, f, jac, k, res = x_new, f_new, jac_new, k_new, res_new
-            if res <= tol or (alpha == 1.0 and np.abs(step[:4]).max() < 1e-14):
-                break
-        else:
-            raise SolverError(f"{self.side} wheel: contact point not found in {max_iter} Newton iterations "
-                              f"(residual {res:.3g}) at q={np.array2string(q, precision=5)}")
+            else:
+                raise SolverError(f"{self.side} wheel: contact point not found in {max_iter} Newton iterations "
+                                  f"(residual {res:.3g}) at q={np.array2string(q, precision=5)}")
         s = x[:4]
         # k are the kernels at s; their pieces are those of an unclipped evaluation unless the
         # point left a profile or the track.
         self._check_inside(s)
         if self.form == "railframe":
-            gap, res = float(k.c[2]), float(np.abs(k.c[[0, 1, 3, 4]]).max())
+            gap, res = float(k.c[2]), float(np.abs(k.c[_CONDITION_ROWS]).max())
         else:
             n = self._normal_from_jacobian(k.C_s)
             gap = float(n @ k.c[:3])
             res = float(np.abs(np.r_[k.c[:3] - gap * n, k.c[3:]]).max())
         if not res < 1e-8:
             raise SolverError(f"{self.side} wheel: Newton stalled at residual {res:.3g} (s={s})")
-        return ContactPoint(np.array(s, float), gap, res, it, self)
+        return ContactPoint(np.array(s, float), gap, res, it, self, k)
 
     def _conditions(self, q, x):
         """The four (rail frame) or five (global, with the gap ``x[4]``) conditions, their
         Jacobian in ``x`` and the kernels at ``x[:4]``."""
         k = self.evaluate(q, x[:4], clip=True)
         if self.form == "railframe":
-            return k.c[[0, 1, 3, 4]], k.C_s[[0, 1, 3, 4]], k
+            return k.c[_CONDITION_ROWS], k.C_s[_CONDITION_ROWS], k
         n = self._normal_from_jacobian(k.C_s)
         jac = np.zeros((5, 5))
         jac[:, :4] = k.C_s  # the normal's dependence on s2r is left out (exact at zero gap)

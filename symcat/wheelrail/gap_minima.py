@@ -1,20 +1,25 @@
 """All local minima of the wheel/rail gap along the wheel profile (the candidates of a contact
-jump, :mod:`symcat.integrate.contact_jumps`)."""
-from __future__ import annotations
+jump, :mod:`symcat.integrate.contact_jumps`), of one wheel or of many at once.
 
-import math
+The search evaluates some 750 wheel circles per wheel; one check of a vehicle looks at every
+wheel. :func:`gap_minima_batch` does each of its phases (the circles' bottoms, the two angles of
+a yawed circle, the parabola's angle) for all wheels in one vectorised pass
+(:class:`.wheel_circles.WheelCircles`: one graph look-up of the rail per rail profile), and
+Newton per minimum; :func:`gap_minima` is one wheel of it.
+"""
+from __future__ import annotations
 
 import numpy as np
 
 from symcat.errors import ParameterError, SolverError
 
-from .constraint_contact import ContactPoint, _rotation
-
+from .contact_point import ContactPoint
+from .wheel_circles import FINE_GRID_M, WheelCircles
 
 #: Safety factor on the predicted lowering of a wheel circle's clearance off its bottom point.
 OFF_BOTTOM_SAFETY = 4.0
-#: Fine grid step (m) of the search near the followed point.
-FINE_GRID_M = 2e-5
+#: Angle step (rad) of the parabola through three points of a yawed circle.
+ANGLE_STEP_RAD = 0.05
 
 
 def gap_minima(contact, q, band_m: float = 2e-6, grid_m: float = 2.5e-4, near: float | None = None,
@@ -41,66 +46,107 @@ def gap_minima(contact, q, band_m: float = 2e-6, grid_m: float = 2.5e-4, near: f
     ------
     SolverError
         If no wheel circle lies above the rail.
+    ParameterError
+        If the axle centre lies off a curved track's defined length.
     """
-    q = np.asarray(q, float)
-    a = _rotation(q[3:7])
-    s_axle = contact.frames.project(q[None, :3])
-    contact.frames.check(s_axle)
-    w = a.T @ contact.frames.up(s_axle)
-    bottom = math.atan2(-w[0], w[2])
-    lo, hi = contact.wheel.s_min, contact.wheel.s_max
-    grid = np.linspace(lo, hi, max(int(math.ceil((hi - lo) / grid_m)), 8) + 1)
-    if near is not None:
-        grid = np.union1d(grid, np.clip(near + np.arange(-1.5e-3, 1.5e-3 + 1e-9, FINE_GRID_M), lo, hi))
-    pw = contact.wheel.position(grid)
-    gap, s2r, s1r = contact._vertical_gap(q, a, bottom, grid, s_axle, pw)
+    found = gap_minima_batch([contact], [q], band_m, grid_m, [near], [known])[0]
+    if isinstance(found, Exception):
+        raise found
+    return found
+
+
+def gap_minima_batch(contacts, qs, band_m: float = 2e-6, grid_m: float = 2.5e-4, nears=None, knowns=None) -> list:
+    """:func:`gap_minima` of several wheels (``contacts`` at wheelset positions ``qs``, with
+    ``nears`` and ``knowns`` per wheel, None by default), each phase of the search done for all
+    of them at once: the same points as wheel by wheel (to rounding of the grid's clearances).
+
+    Returns
+    -------
+    list
+        Per wheel, its points (lowest first), or the :class:`SolverError` or
+        :class:`ParameterError` that :func:`gap_minima` would raise for it.
+    """
+    n = len(contacts)
+    nears = [None] * n if nears is None else list(nears)
+    knowns = [None] * n if knowns is None else list(knowns)
+    out: list = [None] * n
+    qs = [np.asarray(q, float) for q in qs]
+    for j, contact in enumerate(contacts):
+        if contact.frames.kind != "ground":  # tangent track has no ends
+            try:
+                contact.frames.check(contact.frames.project(qs[j][None, :3]))
+            except ParameterError as err:
+                out[j] = err
+    live = [j for j in range(n) if out[j] is None]
+    if not live:
+        return out
+    c = WheelCircles([contacts[j] for j in live], [qs[j] for j in live], grid_m, [nears[j] for j in live])
+    gap, s2r, s1r, slope = c.vertical_gap(c.wid, c.pw, slope=True)
     gap = np.where(np.isfinite(gap), gap, np.inf)
-    if not np.isfinite(gap).any():
-        raise SolverError(f"{contact.side} wheel: no point of the wheel lies above the rail at "
-                          f"q={np.array2string(q, precision=5)} (wheelset off the rail)")
-    # Off-bottom lowering bound per circle (inf where the rail slope is unknown: off the rail).
-    tangent = np.asarray(contact.frames.track_axes(float(s_axle[0])))[:, 0]
-    sin_yaw = float(a[:, 1] @ tangent)
-    slope = np.full(len(grid), np.inf)
-    on = np.isfinite(s2r)
-    d = contact.rail.derivative(s2r[on])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        slope[on] = np.abs(d[:, 1] / d[:, 0])
-    radius = contact._head[1] + pw[:, 1]
-    finite = np.isfinite(slope)
-    lowering = np.full(len(grid), np.inf if sin_yaw != 0.0 else 0.0)
-    lowering[finite] = 0.5 * radius[finite] * (slope[finite] * sin_yaw) ** 2
-    with np.errstate(invalid="ignore"):  # inf - inf off the rail: not a candidate
-        candidate = gap - OFF_BOTTOM_SAFETY * lowering <= gap.min() + band_m
-    candidate &= np.isfinite(gap)
-    s2w = np.full(len(grid), bottom)
-    if sin_yaw != 0.0 and candidate.any():
-        step = 0.05  # rad
-        sub, pw_sub = grid[candidate], pw[candidate]
-        # Both angles in one evaluation (its fixed cost exceeds that of the few circles).
-        angles = bottom + step * np.repeat([-1.0, 1.0], sub.size)
-        g = contact._vertical_gap(q, a, angles, np.tile(sub, 2), s_axle, np.tile(pw_sub, (2, 1)))[0]
-        g = np.nan_to_num(g, nan=np.inf).reshape(2, -1)
-        with np.errstate(invalid="ignore", divide="ignore"):  # inf off the rail
-            curv = g[0] + g[1] - 2 * gap[candidate]
-            shift = np.where(curv > 0, 0.5 * step * (g[0] - g[1]) / curv, 0.0)
-        s2w_sub = bottom + np.clip(np.nan_to_num(shift), -3 * step, 3 * step)
-        moved = s2w_sub != bottom
-        if moved.any():
-            gm, r2m, r1m = contact._vertical_gap(q, a, s2w_sub[moved], sub[moved], s_axle, pw_sub[moved])
-            idx = np.flatnonzero(candidate)[moved]
-            better = np.isfinite(gm) & (gm < gap[idx])
-            i = idx[better]
-            gap[i], s2r[i], s1r[i], s2w[i] = gm[better], r2m[better], r1m[better], s2w_sub[moved][better]
-    lower = (gap <= np.concatenate(([np.inf], gap[:-1]))) & (gap <= np.concatenate((gap[1:], [np.inf])))
-    points: list[ContactPoint] = []
-    for j in np.flatnonzero(lower & (gap <= gap.min() + band_m)):
-        if known is not None and abs(grid[j] - known) <= 1.5 * FINE_GRID_M:
+    low = np.minimum.reduceat(gap, c.starts)
+    for j, g in zip(live, low):
+        if not np.isfinite(g):
+            out[j] = SolverError(f"{contacts[j].side} wheel: no point of the wheel lies above the rail at "
+                                 f"q={np.array2string(qs[j], precision=5)} (wheelset off the rail)")
+    s2w = c.bottom[c.wid]
+    candidate = _off_bottom_candidates(c, gap, slope, low, band_m)
+    if candidate.size:
+        _yawed_circles(c, candidate, gap, s2r, s1r, s2w)
+    # Local minima of each wheel's clearances within the band of its (updated) lowest.
+    prev, nxt = np.concatenate(([np.inf], gap[:-1])), np.concatenate((gap[1:], [np.inf]))
+    prev[c.starts], nxt[c.ends - 1] = np.inf, np.inf
+    low = np.minimum.reduceat(gap, c.starts)
+    picked = np.flatnonzero((gap <= prev) & (gap <= nxt) & (gap <= low[c.wid] + band_m) & np.isfinite(low)[c.wid])
+    starts = np.searchsorted(picked, c.starts)
+    for k, j in enumerate(live):
+        if out[j] is not None:
             continue
-        try:
-            p = contact._newton(q, np.array([grid[j], s2w[j], s1r[j], s2r[j]]), 1e-13, 40)
-        except (SolverError, ParameterError):
-            continue
-        if all(abs(p.s[0] - o.s[0]) > 1e-6 for o in points):
-            points.append(p)
-    return sorted(points, key=lambda p: p.gap_m)
+        points: list[ContactPoint] = []
+        for i in picked[starts[k]:starts[k + 1] if k + 1 < len(live) else None]:
+            if knowns[j] is not None and abs(c.grid[i] - knowns[j]) <= 1.5 * FINE_GRID_M:
+                continue
+            try:
+                p = contacts[j]._newton(qs[j], np.array([c.grid[i], s2w[i], s1r[i], s2r[i]]), 1e-13, 40)
+            except (SolverError, ParameterError):
+                continue
+            if all(abs(p.s[0] - o.s[0]) > 1e-6 for o in points):
+                points.append(p)
+        out[j] = sorted(points, key=lambda p: p.gap_m)
+    return out
+
+
+def _off_bottom_candidates(c, gap, slope, low, band_m) -> np.ndarray:
+    """Circles of yawed wheels whose lowest clearance off the bottom may lie in the band: the
+    bottom's less :data:`OFF_BOTTOM_SAFETY` times the predicted lowering (see
+    :func:`gap_minima`; infinite where the rail slope is unknown: off the rail)."""
+    sin_yaw = c.sin_yaw[c.wid]
+    radius = c.r0[c.wid] + c.pw[1]
+    with np.errstate(invalid="ignore"):  # inf * 0 and inf - inf off the rail: not a candidate
+        unknown = np.where(sin_yaw != 0.0, np.inf, 0.0)
+        lowering = np.where(np.isfinite(slope), 0.5 * radius * (slope * sin_yaw) ** 2, unknown)
+        candidate = gap - OFF_BOTTOM_SAFETY * lowering <= low[c.wid] + band_m
+    return np.flatnonzero(candidate & np.isfinite(gap) & (sin_yaw != 0.0))
+
+
+def _yawed_circles(c, idx, gap, s2r, s1r, s2w) -> None:
+    """Lowest clearance of the circles ``idx`` (ascending) off their bottoms: a parabola through
+    the bottom and :data:`ANGLE_STEP_RAD` either side gives the angle, kept where lower (in
+    place)."""
+    step = ANGLE_STEP_RAD
+    wid, pw = c.wid[idx], c.pw[:, idx]
+    bottom = c.bottom[wid]
+    # Both angles of every circle in one evaluation (its fixed cost exceeds that of the circles),
+    # interleaved so that the circles stay in order of their wheels.
+    angles = (bottom[:, None] + [-step, step]).ravel()
+    g = c.vertical_gap(np.repeat(wid, 2), np.repeat(pw, 2, axis=1), angles)[0]
+    g = np.nan_to_num(g, nan=np.inf).reshape(-1, 2).T
+    with np.errstate(invalid="ignore", divide="ignore"):  # inf off the rail
+        curv = g[0] + g[1] - 2 * gap[idx]
+        shift = np.where(curv > 0, 0.5 * step * (g[0] - g[1]) / curv, 0.0)
+    s2w_sub = bottom + np.clip(np.nan_to_num(shift), -3 * step, 3 * step)
+    moved = np.flatnonzero(s2w_sub != bottom)
+    if moved.size:
+        gm, r2m, r1m = c.vertical_gap(wid[moved], pw[:, moved], s2w_sub[moved])
+        better = np.isfinite(gm) & (gm < gap[idx[moved]])
+        i = idx[moved][better]
+        gap[i], s2r[i], s1r[i], s2w[i] = gm[better], r2m[better], r1m[better], s2w_sub[moved][better]

@@ -27,11 +27,14 @@ from __future__ import annotations
 
 import math
 import warnings
+from functools import cached_property
 
 import numpy as np
 from scipy.interpolate import BSpline, PPoly, make_interp_spline, splprep
 
 from symcat.errors import ParameterError
+
+from .piecewise_cubic import GraphBrackets, PiecewiseCubic
 
 KINDS = ("wheel", "rail")
 DEFAULT_SMOOTHING_M = 2e-7
@@ -199,30 +202,30 @@ class Profile:
         (largest ``z`` where the curve passes ``y`` more than once); NaN outside the profile."""
         return self.envelope_at(y)[0]
 
-    def envelope_at(self, y) -> tuple[np.ndarray, np.ndarray]:
+    def envelope_at(self, y, slope: bool = False) -> tuple:
         """Parameter and ``z`` [m] of the point at lateral ``y`` [m] on the envelope facing the
         other body (largest ``z`` where the curve passes ``y`` more than once): ``(s, z)``,
-        ``(NaN, -inf)`` outside the profile."""
+        ``(NaN, -inf)`` outside the profile; with ``slope`` also ``dz/dy`` there (NaN outside):
+        ``(s, z, dz/dy)``."""
         y = np.asarray(y, float)
         flat = y.ravel()
-        best_s = np.full(flat.shape, np.nan)
-        best_z = np.full(flat.shape, -np.inf)
-        for lo, hi in self._pieces:
-            ys = self._ytab[lo:hi + 1]
-            ss = self._stab[lo:hi + 1]
-            if ys[-1] < ys[0]:
-                ys, ss = ys[::-1], ss[::-1]
-            inside = (flat >= ys[0]) & (flat <= ys[-1])
+        best = [np.full(flat.shape, np.nan), np.full(flat.shape, -np.inf)]
+        if slope:
+            best.append(np.full(flat.shape, np.nan))
+        for graph in self._graph:
+            inside = (flat >= graph.ys[0]) & (flat <= graph.ys[-1])
             if not inside.any():
                 continue
-            q = flat[inside]
-            i = np.clip(np.searchsorted(ys, q) - 1, 0, len(ys) - 2)
-            s, z = self._newton_y(q, ss[i], ss[i + 1], ys[i], ys[i + 1])
-            better = z > best_z[inside]
+            found = graph.solve(flat[inside], slope=slope)
+            if len(self._graph) == 1:  # one monotone piece (most profiles): nothing to compare
+                for b, f in zip(best, found):
+                    b[inside] = f
+                continue
+            better = found[1] > best[1][inside]
             idx = np.flatnonzero(inside)[better]
-            best_s[idx] = s[better]
-            best_z[idx] = z[better]
-        return best_s.reshape(y.shape), best_z.reshape(y.shape)
+            for b, f in zip(best, found):
+                b[idx] = f[better]
+        return tuple(b.reshape(y.shape) for b in best)
 
     def z_at(self, y) -> np.ndarray:
         """``z`` [m] at lateral ``y`` [m] on the envelope facing the other body; NaN outside."""
@@ -241,6 +244,13 @@ class Profile:
         return out
 
     # ------------------------------------------------------------------ other forms
+    @cached_property
+    def cubic(self) -> PiecewiseCubic:
+        """The curve as a :class:`.piecewise_cubic.PiecewiseCubic` (:meth:`piecewise_polynomial`):
+        lean evaluation for the many small calls of the contact searches."""
+        pp = self.piecewise_polynomial()
+        return PiecewiseCubic(pp.x, pp.c)
+
     def piecewise_polynomial(self) -> PPoly:
         """The curve as a piecewise cubic: ``pp.x`` the breakpoints (strictly increasing),
         ``pp.c`` of shape ``(4, len(pp.x) - 1, 2)``, so that on ``[x_i, x_i+1]``
@@ -302,34 +312,7 @@ class Profile:
             current = sg
         pieces.append((start, len(s) - 1))
         self._pieces = pieces
-
-    def _newton_y(self, q, s_lo, s_hi, y_lo, y_hi):
-        """``(s, z(s))`` where ``y(s) = q`` (1-D arrays): safeguarded Newton inside table brackets
-        (``y`` monotone there), four steps. A point that a step leaves unchanged would stay there:
-        after the second step (the first moves nearly all) the steps go on with the others only,
-        and the ``z`` of a point is that of its last evaluation."""
-        z = np.empty_like(q)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            frac = np.where(y_hi != y_lo, (q - y_lo) / (y_hi - y_lo), 0.5)
-            s = s_lo + frac * (s_hi - s_lo)
-            active = slice(None)
-            for k in range(4):
-                s_a = s[active]
-                r = self._derivs[0](s_a)
-                z[active] = r[:, 1]
-                d = self._derivs[1](s_a)[:, 0]
-                step = np.where(d != 0, (r[:, 0] - q[active]) / d, 0.0)
-                new = np.minimum(np.maximum(s_a - step, s_lo[active]), s_hi[active])  # np.clip, faster
-                moved = np.flatnonzero(new != s_a)  # before s is written: s_a may be a view of it
-                s[active] = new
-                if k == 0:
-                    continue  # nearly every point moves in the first step: all take the second
-                if not moved.size:
-                    break
-                active = moved if isinstance(active, slice) else active[moved]
-            else:  # the last step moved these: their z is not yet that of their s
-                z[active] = self._derivs[0](s[active])[:, 1]
-        return s, z
+        self._graph = [GraphBrackets(self.cubic, s[lo:hi + 1], self._ytab[lo:hi + 1]) for lo, hi in pieces]
 
 
 def validate_points(y, z, label: str = "profile", *, min_points: int = 10, min_span_m: float = 0.005,

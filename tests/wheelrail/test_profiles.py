@@ -109,8 +109,8 @@ def test_graph_lookup_round_trip_including_steep_faces():
 
 
 def test_envelope_lookup_equals_the_full_newton():
-    """s_at's Newton drops the points a step leaves unchanged (and keeps their last z): the
-    same bits as four full steps and a final evaluation."""
+    """s_at's Newton (on the piecewise cubic, from a cubic start, stopping once converged)
+    gives the point of four full Newton steps on the scipy spline to rounding, and its slope."""
     r = load_profile("UIC60_canted_1in40")
     y = np.random.default_rng(3).uniform(*r.y_range, 500)
     s, z = r.envelope_at(y)
@@ -121,8 +121,25 @@ def test_envelope_lookup_equals_the_full_newton():
     for _ in range(4):
         ref = np.clip(ref - (r.position(ref)[:, 0] - y) / r.derivative(ref)[:, 0], ss[i], ss[i + 1])
     assert len(r._pieces) == 1
-    assert np.array_equal(s, ref) and np.array_equal(z, r.position(ref)[:, 1])
+    np.testing.assert_allclose(s, ref, rtol=0, atol=2e-15)
+    np.testing.assert_allclose(z, r.position(ref)[:, 1], rtol=0, atol=2e-15)
     assert np.array_equal(r.s_at(y), s)
+    s2, z2, slope = r.envelope_at(y, slope=True)
+    assert np.array_equal(s2, s) and np.array_equal(z2, z)
+    np.testing.assert_allclose(slope, r.slope(s), rtol=1e-12, atol=1e-15)
+    assert np.isnan(r.envelope_at([r.y_range[1] + 1e-3], slope=True)[2]).all()
+
+
+def test_envelope_of_a_folded_curve_takes_the_highest_branch():
+    """Where y(s) turns back (three monotone pieces) the envelope is the branch of largest z."""
+    u = np.linspace(-1.5, 1.5, 301)
+    r = Profile.from_parametric(0.01 * u, 0.01 * (u**3 - u), 0.01 * u, "rail")
+    assert len(r._pieces) >= 3
+    y = np.linspace(-0.0035, 0.0035, 29)  # where all three branches pass
+    top = [max(root.real for root in np.roots([1.0, 0.0, -1.0, -v / 0.01]) if abs(root.imag) < 1e-9) for v in y]
+    s, z = r.envelope_at(y)
+    np.testing.assert_allclose(z, 0.01 * np.array(top), atol=1e-12)
+    np.testing.assert_allclose(r.position(s)[:, 0], y, atol=1e-12)
 
 
 def test_normals_point_out_of_the_material():
