@@ -125,7 +125,8 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     z0 = np.zeros(sum(b.size for b in zb.values()))
     creep = CreepCoupling(form, q, v, s, w)
     if form.formulation == "augmented":
-        a, s_dd, lam = creep.solve(lambda force: kkt_solve_closed(m, force, cq, cs, qd, closed, form.n_c), f)
+        solve = kkt_solver_closed(m, cq, cs, closed, form.n_c)  # one factorization for every creep pass
+        a, s_dd, lam = creep.solve(lambda force: solve(force, qd), f)
         values_x = {"q": q, "s": s, "v": v, "w": w}
         values_z = {"a": a, "s_dd": s_dd, "w": w, "lambda": lam, "mu": np.zeros(form.n_c), "sc": sc}
     else:
