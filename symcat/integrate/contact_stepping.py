@@ -22,6 +22,13 @@ a predicted contact jump (on the grid, the calls would close in on it by halves:
 calls and checks per jump), and, from such an end, one call back to the grid at the level the
 span allows (on the grid, the calls would double from the finest level up). On an S1002
 vehicle this halves the calls (170 -> 93 per simulated second).
+
+A call that continues the last one starts with about IDAS's last step there (GGL only,
+:meth:`ContactStepper._first_step`) rather than 1e-3 of the call, from which IDAS needs ten
+steps with a Jacobian set-up each to grow back; and a jump found late is redone once, as a free
+call to its estimated time, rather than by halving calls (:meth:`ContactStepper._late_jump`).
+On the S1002 vehicle at rtol 1e-4 the two took 1859 steps, 1081 set-ups and 109 calls per
+simulated second to 1041, 465 and 77.
 """
 from __future__ import annotations
 
@@ -34,18 +41,16 @@ from ..errors import ParameterError, SolverError
 from .contact_jumps import MIN_SPAN_S, check_contacts, jump_contacts, lost_contact
 from .contact_switching import Switching
 from .failure import split_state
+from .shifted import shifted_dae
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
 #: IDAS's first step in a call, relative to the call's length, when no earlier step suggests one
 #: (the first call, after a failure): ``2^-FIRST_STEP_LEVELS``, about 1e-3.
 FIRST_STEP_LEVELS = 10
-#: The first step of a call is IDAS's last step in the previous one, rounded down to ``2^-k``
-#: of the call with ``k`` a multiple of this (one integrator per level and grid: building one
-#: costs about 10 ms, as much as 10 steps). IDAS restarts at order 1, whose error test the
-#: last step (of order up to 5) may fail: then it shrinks the step, at a few Jacobian set-ups;
-#: a quarter of the last step measured worse (S1002 vehicle, rtol 1e-4: 1193 steps instead of
-#: 1063). After a jump the step stays: the velocities change, but not the time scales.
+#: The first step of a call that continues the last one (:meth:`ContactStepper._first_step`)
+#: is rounded down to ``2^-k`` of the call with ``k`` a multiple of this: one integrator per
+#: level and grid, and building one costs about 10 ms, as much as 10 steps.
 FIRST_STEP_LEVEL_STEP = 3
 #: Integrators kept (one per call grid and linear solver; a long run meets many grids).
 MAX_INTEGRATORS = 64
@@ -116,7 +121,8 @@ class ContactStepper:
         # passed unnoticed), and the retry, shorter and after a jump check, beats waiting.
         self.opts["max_num_steps"] = min(int(opts.get("max_num_steps", MAX_CALL_STEPS)), MAX_CALL_STEPS)
         self.set_dae(dae_fn)
-        self.step_hint = None  # IDAS's first step in the next call (s), see _first_step_level
+        self.step_hint = None  # IDAS's last step in the last call (s), see _first_step
+        self._start = None  # (t, x_dot) at the last call's start, see _first_step
         self.refused: dict[str, tuple[float, float]] = {}  # contact -> (wheel parameter, until t)
         self._jumped_from = None  # (t, x, z, [(contact, new wheel parameter)]) of the last jump
         self.checks = check_contacts(form, x, z)
@@ -140,19 +146,18 @@ class ContactStepper:
         p = np.r_[t_a, self.switching.open]
         grid = [float(v) for v in inner] + [h]
         x = np.asarray(x, float)
-        x_dot = None
+        x_dot = np.asarray(self.dae_fn(0.0, x, z, p, ca.DM(0, 1))[0]).ravel()
+        scale = 1.0 + self.opts["reltol"] * np.abs(x) / self._atol(len(x))
+        first = self._first_step(t_a, x, x_dot)
         exc = None
         for n, (solver, shifted) in enumerate(self._attempts()):
             if n:
                 self.stats["contact_fallbacks"] += 1
             normalized = free and shifted
-            level = self._first_step_level(h) if shifted else 0
+            level = self._first_step_level(h, first) if shifted else 0
             integ = self._integrator([v / h for v in grid] if normalized else grid, solver, shifted, normalized, level)
             try:
                 if shifted:
-                    if x_dot is None:
-                        x_dot = np.asarray(self.dae_fn(0.0, x, z, p, ca.DM(0, 1))[0]).ravel()
-                        scale = 1.0 + self.opts["reltol"] * np.abs(x) / self._atol(len(x))
                     p_ext = np.r_[p, x, x_dot, scale, h] if normalized else np.r_[p, x, x_dot, scale]
                     out = integ(x0=np.zeros(len(x)), z0=z, p=p_ext)
                 else:
@@ -172,18 +177,35 @@ class ContactStepper:
             return xs, np.asarray(out["zf"])
         raise exc
 
-    def _first_step_level(self, h: float) -> int:
-        """``k`` of IDAS's first step ``h / 2^k`` in a call of length ``h`` (s): from
-        :attr:`step_hint` (IDAS's last step in the previous call, when this one continues it),
-        else :data:`FIRST_STEP_LEVELS`. Restarting from about 1e-3 of the call, IDAS takes ten
-        steps, each with a Jacobian set-up, to double its step back up: most of the steps of a
-        model with a hundred calls per simulated second. Only with GGL stabilization: index 1
-        leaves the position constraints to drift, and its first steps at order 1 and the last
-        step's size drift more (the cant-ramp wheelset: 1.05e-4 m over 0.8 s instead of
-        4.6e-5 m)."""
-        if self.step_hint is None:
+    def _first_step(self, t_a: float, x, x_dot) -> float | None:
+        """IDAS's first step (s) in a call from ``(t_a, x)`` that continues the last one: its
+        last step there (:attr:`step_hint`), at most the step whose order-1 error is half the
+        tolerance, ``sqrt(||x''||^-1)`` in IDAS's weighted RMS norm, with ``x''`` the change of
+        ``x_dot`` since the last call's start (none across a jump: ``_start`` is cleared). IDAS
+        restarts at order 1, whose error test a last step taken at order 3 to 5 fails: on the
+        conical vehicle the bare last step took 603 steps per simulated second instead of 417.
+        ``None``: no hint (the first call, after a failure; index 1, see
+        :meth:`_first_step_level`)."""
+        last, self._start = self._start, (t_a, x_dot)
+        hint = self.step_hint
+        if hint is None or last is None or not t_a > last[0]:
+            return hint
+        x_dd = (x_dot - last[1]) / (t_a - last[0])
+        weights = 1.0 / (self.opts["reltol"] * np.abs(x) + self._atol(len(x)))
+        norm = float(np.sqrt(np.mean((x_dd * weights) ** 2)))
+        return min(hint, 1.0 / math.sqrt(norm)) if norm > 0 else hint
+
+    def _first_step_level(self, h: float, first: float | None) -> int:
+        """``k`` of IDAS's first step ``h / 2^k`` in a call of length ``h`` (s): ``first``
+        (:meth:`_first_step`) rounded down to a level, else :data:`FIRST_STEP_LEVELS`.
+        Restarting from about 1e-3 of the call, IDAS takes ten steps, each with a Jacobian
+        set-up, to double its step back up: most of the steps of a model with a hundred calls
+        per simulated second. Only with GGL stabilization: index 1 leaves the position
+        constraints to drift, and its first steps at order 1 and the last step's size drift
+        more (the cant-ramp wheelset: 1.05e-4 m over 0.8 s instead of 4.6e-5 m)."""
+        if first is None:
             return FIRST_STEP_LEVELS
-        k = max(0, math.ceil(math.log2(h / self.step_hint) - 1e-9))
+        k = max(0, math.ceil(math.log2(h / first) - 1e-9))
         return min(FIRST_STEP_LEVELS, FIRST_STEP_LEVEL_STEP * math.ceil(k / FIRST_STEP_LEVEL_STEP))
 
     def _integrator(self, grid, solver: str, shifted: bool, normalized: bool = False, level: int = FIRST_STEP_LEVELS):
@@ -293,6 +315,8 @@ class ContactStepper:
                 self._jumped_from = (t, x_from, z_from, [(n, float(s[index[n]])) for n in jumped])
             checks = check_contacts(self.form, x, z)
         x, z, switched = self.switching.update(x, z, t, checks)
+        if jumped or switched:
+            self._start = None  # x_dot jumped: no second derivative across
         if switched:
             for s in switched:
                 self.stats["lift_offs" if s.kind == "lift-off" else "touchdowns"] += 1
@@ -426,24 +450,3 @@ class ContactStepper:
                 raise SolverError(f"at t = {t_b:.6g} s {reason}; the results so far are in .partial")
         return x, z
 
-
-def shifted_dae(dae_fn: ca.Function, normalized: bool = False) -> ca.Function:
-    """The DAE ``(t, x, z, p, u) -> (ode, alg, quad, zero)`` in the state's scaled departure from
-    its linear extrapolation: ``x = x_a + t x_dot_a + D xi``, ``xi_dot = (ode - x_dot_a) / D``,
-    with ``p`` extended by ``x_a``, ``x_dot_a`` and ``D``. ``xi = 0`` with ``xi_dot = 0`` is a
-    consistent start when ``x_dot_a`` is the DAE's own ``ode`` there (see the module docstring).
-    ``normalized``: in the time ``tau = t / h``, with ``p`` extended further by ``h`` (s), so
-    that one integrator on ``tau`` in ``[0, 1]`` serves calls of every length."""
-    n_x, n_z, n_p = dae_fn.size1_in(1), dae_fn.size1_in(2), dae_fn.size1_in(3)
-    tau, xi, z = ca.MX.sym("t"), ca.MX.sym("xi", n_x), ca.MX.sym("z", n_z)
-    p_ext, u = ca.MX.sym("p", n_p + 3 * n_x + int(normalized)), ca.MX.sym("u", dae_fn.size1_in(4))
-    p, x_a = p_ext[:n_p], p_ext[n_p : n_p + n_x]
-    x_dot_a, scale = p_ext[n_p + n_x : n_p + 2 * n_x], p_ext[n_p + 2 * n_x : n_p + 3 * n_x]
-    h = p_ext[-1] if normalized else None
-    t = tau if h is None else h * tau
-    ode, alg, quad, zero = dae_fn(t, x_a + t * x_dot_a + scale * xi, z, p, u)
-    xi_dot = (ode - x_dot_a) / scale
-    if h is not None:
-        xi_dot, quad = h * xi_dot, h * quad
-    return ca.Function(f"{dae_fn.name()}_shifted", [tau, xi, z, p_ext, u], [xi_dot, alg, quad, zero],
-                       dae_fn.name_in(), dae_fn.name_out())

@@ -22,7 +22,7 @@ def test_first_step_is_the_last_one_rounded_down_to_a_level(hint, level):
     """IDAS's first step ``h / 2^k``: the previous call's last step rounded down to a level
     (never above it, never above the call), the default without one."""
     h = 1e-2
-    k = _stepper(None if hint is None else hint * h)._first_step_level(h)
+    k = _stepper()._first_step_level(h, None if hint is None else hint * h)
     assert k == level
     if hint is not None and k < FIRST_STEP_LEVELS:
         assert h / 2**k <= min(hint, 1.0) * h * (1 + 1e-12)
