@@ -23,12 +23,10 @@ calls and checks per jump), and, from such an end, one call back to the grid at 
 span allows (on the grid, the calls would double from the finest level up). On an S1002
 vehicle this halves the calls (170 -> 93 per simulated second).
 
-A call that continues the last one starts with about IDAS's last step there (GGL only,
-:meth:`ContactStepper._first_step`) rather than 1e-3 of the call, from which IDAS needs ten
-steps with a Jacobian set-up each to grow back; and a jump found late is redone once, as a free
-call to its estimated time, rather than by halving calls (:meth:`ContactStepper._late_jump`).
-On the S1002 vehicle at rtol 1e-4 the two took 1859 steps, 1081 set-ups and 109 calls per
-simulated second to 1041, 465 and 77.
+A continuing call starts with about IDAS's last step (GGL, :meth:`ContactStepper._first_step`),
+not 1e-3 of the call; a jump found late is redone once, to its estimated time
+(:meth:`ContactStepper._late_jump`). S1002 vehicle, rtol 1e-4: 1859 steps, 1081 Jacobian
+set-ups and 109 calls per simulated second became 1041, 465 and 77.
 """
 from __future__ import annotations
 
