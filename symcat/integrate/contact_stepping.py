@@ -43,8 +43,9 @@ from .shifted import shifted_dae
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
-#: IDAS's first step in a call, relative to the call's length, when no earlier step suggests one
-#: (the first call, after a failure): ``2^-FIRST_STEP_LEVELS``, about 1e-3.
+#: IDAS's first step relative to the call without a suggested one (first call, failure, index 1).
+INITIAL_STEP = 1e-3
+#: Largest level ``k`` of a suggested first step ``2^-k`` of the call (about 1e-3).
 FIRST_STEP_LEVELS = 10
 #: The first step of a call that continues the last one (:meth:`ContactStepper._first_step`)
 #: is rounded down to ``2^-k`` of the call with ``k`` a multiple of this: one integrator per
@@ -55,8 +56,7 @@ MAX_INTEGRATORS = 64
 #: A jump target this deep at a call's end (m) means the jump came late: the call is redone
 #: shorter (:meth:`ContactStepper._late_jump`).
 LATE_JUMP_GAP_M = 1e-8
-#: A late jump's call is redone to this fraction of the estimated crossing time
-#: (:meth:`ContactStepper._late_jump`), so that the rival is found above the followed point.
+#: A late jump's call is redone to this fraction of the estimated crossing (the rival then above).
 LATE_JUMP_EARLY = 0.9
 #: Least fraction of a call that a late jump's redo keeps (:meth:`ContactStepper._late_jump`).
 LATE_JUMP_MIN_FRACTION = 0.25
@@ -152,7 +152,7 @@ class ContactStepper:
             if n:
                 self.stats["contact_fallbacks"] += 1
             normalized = free and shifted
-            level = self._first_step_level(h, first) if shifted else 0
+            level = self._first_step_level(h, first) if shifted else None
             integ = self._integrator([v / h for v in grid] if normalized else grid, solver, shifted, normalized, level)
             try:
                 if shifted:
@@ -182,8 +182,7 @@ class ContactStepper:
         ``x_dot`` since the last call's start (none across a jump: ``_start`` is cleared). IDAS
         restarts at order 1, whose error test a last step taken at order 3 to 5 fails: on the
         conical vehicle the bare last step took 603 steps per simulated second instead of 417.
-        ``None``: no hint (the first call, after a failure; index 1, see
-        :meth:`_first_step_level`)."""
+        ``None``: no hint (first call, after a failure, index 1: :meth:`_first_step_level`)."""
         last, self._start = self._start, (t_a, x_dot)
         hint = self.step_hint
         if hint is None or last is None or not t_a > last[0]:
@@ -193,25 +192,25 @@ class ContactStepper:
         norm = float(np.sqrt(np.mean((x_dd * weights) ** 2)))
         return min(hint, 1.0 / math.sqrt(norm)) if norm > 0 else hint
 
-    def _first_step_level(self, h: float, first: float | None) -> int:
+    def _first_step_level(self, h: float, first: float | None) -> int | None:
         """``k`` of IDAS's first step ``h / 2^k`` in a call of length ``h`` (s): ``first``
-        (:meth:`_first_step`) rounded down to a level, else :data:`FIRST_STEP_LEVELS`.
+        (:meth:`_first_step`) rounded down to a level, else ``None`` (:data:`INITIAL_STEP`).
         Restarting from about 1e-3 of the call, IDAS takes ten steps, each with a Jacobian
         set-up, to double its step back up: most of the steps of a model with a hundred calls
         per simulated second. Only with GGL stabilization: index 1 leaves the position
         constraints to drift, and its first steps at order 1 and the last step's size drift
         more (the cant-ramp wheelset: 1.05e-4 m over 0.8 s instead of 4.6e-5 m)."""
         if first is None:
-            return FIRST_STEP_LEVELS
+            return None
         k = max(0, math.ceil(math.log2(h / first) - 1e-9))
         return min(FIRST_STEP_LEVELS, FIRST_STEP_LEVEL_STEP * math.ceil(k / FIRST_STEP_LEVEL_STEP))
 
-    def _integrator(self, grid, solver: str, shifted: bool, normalized: bool = False, level: int = FIRST_STEP_LEVELS):
+    def _integrator(self, grid, solver: str, shifted: bool, normalized: bool = False, level: int | None = None):
         """The integrator of the shifted DAE (or, not ``shifted``, of the DAE itself with
         IDACalcIC) on ``grid`` with ``solver``, built on first use; ``normalized``: the shifted
-        DAE in time normalized by the call's length (``grid`` in ``(0, 1]``); ``level``: IDAS's
-        first step is ``2^-level`` of the call (:meth:`_first_step_level`)."""
-        key = (solver, shifted, normalized, level) + tuple(float(f"{v:.12e}") for v in grid)  # intervals differ in the last bits
+        DAE in time normalized by the call's length (``grid`` in ``(0, 1]``); IDAS's first step
+        is ``2^-level`` of the call (:meth:`_first_step_level`), :data:`INITIAL_STEP` if None."""
+        key = (solver, shifted, normalized, level) + tuple(float(f"{v:.12e}") for v in grid)  # last bits differ
         integ = self._integrators.get(key)
         if integ is None:
             if shifted:
@@ -220,7 +219,8 @@ class ContactStepper:
                 # IDAS's first step would be a thousandth of the first output time (xi_dot = 0
                 # gives it no other scale): the call's length instead, so that the steps do not
                 # depend on the outputs inside the call.
-                dae, opts = self._shifted[normalized], {**self.opts, "calc_ic": False, "step0": 2.0**-level * grid[-1]}
+                step0 = (INITIAL_STEP if level is None else 2.0**-level) * grid[-1]
+                dae, opts = self._shifted[normalized], {**self.opts, "calc_ic": False, "step0": step0}
             else:
                 dae, opts = self.dae_fn, self.opts
             if len(self._integrators) >= MAX_INTEGRATORS:

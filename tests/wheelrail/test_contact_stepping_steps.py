@@ -16,7 +16,7 @@ def _stepper(hint=None, checks=()):
     return stepper
 
 
-@pytest.mark.parametrize("hint, level", [(None, FIRST_STEP_LEVELS), (1.0, 0), (2.0, 0), (0.5, FIRST_STEP_LEVEL_STEP),
+@pytest.mark.parametrize("hint, level", [(None, None), (1.0, 0), (2.0, 0), (0.5, FIRST_STEP_LEVEL_STEP),
                                          (1 / 9, 2 * FIRST_STEP_LEVEL_STEP), (1e-9, FIRST_STEP_LEVELS)])
 def test_first_step_is_the_last_one_rounded_down_to_a_level(hint, level):
     """IDAS's first step ``h / 2^k``: the previous call's last step rounded down to a level
@@ -24,7 +24,7 @@ def test_first_step_is_the_last_one_rounded_down_to_a_level(hint, level):
     h = 1e-2
     k = _stepper()._first_step_level(h, None if hint is None else hint * h)
     assert k == level
-    if hint is not None and k < FIRST_STEP_LEVELS:
+    if k is not None and k < FIRST_STEP_LEVELS:
         assert h / 2**k <= min(hint, 1.0) * h * (1 + 1e-12)
 
 
