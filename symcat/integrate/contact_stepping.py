@@ -26,7 +26,7 @@ vehicle this halves the calls (170 -> 93 per simulated second).
 A continuing call starts with about IDAS's last step (GGL, :meth:`ContactStepper._first_step`),
 not 1e-3 of the call; a jump found late is redone once, to its estimated time
 (:meth:`ContactStepper._late_jump`). S1002 vehicle, rtol 1e-4: 1859 steps, 1081 Jacobian
-set-ups and 109 calls per simulated second became 1041, 465 and 77.
+set-ups and 109 calls per simulated second became 1098, 534 and 89.
 """
 from __future__ import annotations
 
@@ -167,8 +167,7 @@ class ContactStepper:
             for k in self.stat_keys:
                 self.stats[k] += int(st.get(k, 0))
             last = float(st.get("hlast", math.nan)) * (h if normalized else 1.0)
-            hinted = n == 0 and self.form.index == "ggl" and math.isfinite(last) and last > 0
-            self.step_hint = last if hinted else None
+            self.step_hint = last if n == 0 and math.isfinite(last) and last > 0 else None
             xs = np.asarray(out["xf"])
             if shifted:
                 xs = x[:, None] + np.outer(x_dot, grid) + scale[:, None] * xs
@@ -184,7 +183,7 @@ class ContactStepper:
         conical vehicle the bare last step took 603 steps per simulated second instead of 417.
         ``None``: no hint (first call, after a failure, index 1: :meth:`_first_step_level`)."""
         last, self._start = self._start, (t_a, x_dot)
-        hint = self.step_hint
+        hint = self.step_hint if self.form.index == "ggl" else None
         if hint is None or last is None or not t_a > last[0]:
             return hint
         x_dd = (x_dot - last[1]) / (t_a - last[0])
@@ -199,7 +198,7 @@ class ContactStepper:
         set-up, to double its step back up: most of the steps of a model with a hundred calls
         per simulated second. Only with GGL stabilization: index 1 leaves the position
         constraints to drift, and its first steps at order 1 and the last step's size drift
-        more (the cant-ramp wheelset: 1.05e-4 m over 0.8 s instead of 4.6e-5 m)."""
+        more (the cant-ramp wheelset: 1.05e-4 m over 0.8 s instead of 3.9e-5 m)."""
         if first is None:
             return None
         k = max(0, math.ceil(math.log2(h / first) - 1e-9))
