@@ -30,6 +30,19 @@ log = logging.getLogger(__name__)
 #: functions with thousands of outputs (measured).
 CFLAGS = ("-O1", "-fno-tree-dominator-opts", "-fPIC", "-shared")
 
+#: CasADi Function options that merge common subexpressions (as the kernels are built:
+#: ``kernels.FUNCTION_OPTIONS``, ``multibody_kernels.OPTS``, whose jacobian companions repeat
+#: :func:`merged`; they would call it at the next ``make generate``).
+CSE_OPTIONS = {"cse": True}
+
+
+def merged(fn: ca.Function) -> ca.Function:
+    """The SX function ``fn`` rebuilt with :data:`CSE_OPTIONS` (``jacobian`` and ``expand``
+    return functions without them)."""
+    args = fn.sx_in()
+    return ca.Function(fn.name(), args, fn.call(args), fn.name_in(), fn.name_out(), CSE_OPTIONS)
+
+
 #: Counts compiler invocations of this process (the tests check that a warm run makes none).
 COMPILE_COUNT = {"n": 0}
 
