@@ -52,6 +52,10 @@ from .failure import physical_coordinates, restart_point, split_state
 
 #: A minimum this much below the followed point (m) triggers a jump.
 JUMP_TOLERANCE_M = 1e-9
+#: Horizon (s) of an early jump: a rival predicted to sink below the followed point within it
+#: is jumped to at once, if it lies no higher than the caller's ``early_m`` (see
+#: :meth:`ContactCheck.target`).
+EARLY_JUMP_S = 1e-4
 #: Stationary points closer than this along the wheel profile (m) are the same point.
 SAME_POINT_M = 1e-6
 #: Farthest (m) the followed point's own stationary point is looked for from its parameters.
@@ -133,7 +137,7 @@ class ContactCheck:
         """Rival's gap minus the followed point's (m)."""
         return rival.point.gap_m - self.gap_m
 
-    def target(self, relaxed: bool = False, refused: float | None = None) -> Rival | None:
+    def target(self, relaxed: bool = False, refused: float | None = None, early_m: float = 0.0) -> Rival | None:
         """The rival to jump to, if any: the lowest formed one once it lies
         :data:`JUMP_TOLERANCE_M` below the followed point; or, when the followed point nears its
         fold, the lowest one not higher than that tolerance, formed ones first (in a flat valley
@@ -141,13 +145,23 @@ class ContactCheck:
         followed one is about to vanish); or, ``relaxed`` (IDAS has failed on the followed
         point), the lowest one. ``refused``: the wheel parameter (m) of a point IDAS could not
         integrate from just before; rivals within :data:`REFUSED_RADIUS_M` of it are not
-        targets unless ``relaxed``."""
+        targets unless ``relaxed``.
+
+        ``early_m`` (m): a formed rival at most this high that is predicted to sink below within
+        :data:`EARLY_JUMP_S` is a target now. On a symmetric vehicle the wheels of one side
+        reach their jumps microseconds apart: one by one, each jump costs an integrator call,
+        a contact check and a projection; early, they go together, and the call that would close
+        in on the crossing is spared. The wheelset rises by the rival's height at most (a
+        fraction of the position tolerance, set by the caller)."""
         rivals = self.rivals
         if refused is not None and not relaxed:
             rivals = [r for r in rivals if abs(r.point.s[0] - refused) > REFUSED_RADIUS_M]
         formed = [r for r in rivals if r.formed]
-        if formed and self.margin_m(formed[0]) < -JUMP_TOLERANCE_M:
-            return formed[0]
+        if formed:
+            margin = self.margin_m(formed[0])
+            closing = self.gap_rate_m_s - formed[0].gap_rate_m_s
+            if margin < -JUMP_TOLERANCE_M or (margin <= early_m and margin - closing * EARLY_JUMP_S < -JUMP_TOLERANCE_M):
+                return formed[0]
         if relaxed:
             return rivals[0] if rivals else None
         if self.curvature_per_m < FOLD_CURVATURE_PER_M:
@@ -365,11 +379,13 @@ def lost_contact(form, x, z, checks) -> str | None:
     return None
 
 
-def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False, open_rows=(), refused=None):
+def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False, open_rows=(), refused=None,
+                  early_m: float = 0.0):
     """``(x, z, names)``: the state after moving every contact with a :meth:`ContactCheck.target`
     there (``names`` lists them; unchanged state and an empty list if none). ``checks`` are those
     of :func:`check_contacts` at this state (computed if not given); ``refused``: contact name ->
-    wheel parameter (m) of a target to skip (:meth:`ContactCheck.target`)."""
+    wheel parameter (m) of a target to skip; ``early_m``: height (m) up to which a rival about
+    to sink below is a target (:meth:`ContactCheck.target`)."""
     refused = refused or {}
     model = form.model
     if not model.wheelrail:
@@ -380,7 +396,7 @@ def jump_contacts(form, x, z, t: float, checks=None, relaxed: bool = False, open
     jumped = []
     deepest = 0.0
     for e, c in zip(model.wheelrail, checks):
-        rival = c.target(relaxed, refused.get(e.joint.name))
+        rival = c.target(relaxed, refused.get(e.joint.name), early_m)
         if rival is None:
             continue
         deepest = max(deepest, abs(rival.point.gap_m))

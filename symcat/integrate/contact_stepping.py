@@ -8,7 +8,7 @@ about 0.1 s; the output times inside a call are interpolated by IDAS), aligned s
 up to it exactly, and one integrator per call grid serves all calls on that grid. IDAS needs a
 consistent ``x_dot`` at each start, which CasADi takes from a construction option: the
 integrator therefore solves for the state's departure from its linear extrapolation,
-``x = x_a + (t - t_a) x_dot_a + D xi`` (:func:`shifted_dae`), whose consistent start is
+``x = x_a + (t - t_a) x_dot_a + D xi`` (:func:`.shifted.shifted_dae`), whose consistent start is
 ``xi = 0``, ``xi_dot = 0`` for every call; ``x_a``, ``x_dot_a`` (the DAE's own, exact for a
 consistent ``z``) and ``D`` are parameters. The scaling ``D = 1 + rtol |x_a| / atol`` keeps
 IDAS's error weights those of ``x`` (its relative part measured on ``xi`` alone would tighten
@@ -16,17 +16,29 @@ the test on large coordinates). This spares both a fresh integrator per call (10
 compiled DAE, 50 ms over the graph) and IDACalcIC (30 % of the wall time of an S1002 vehicle),
 which remains the last resort (:meth:`ContactStepper._attempts`).
 
-Two kinds of call leave the binary grid (*free* calls, in the normalized time
-``tau = (t - t_a) / h``, where one integrator serves every length): a call that ends exactly at
-a predicted contact jump (on the grid, the calls would close in on it by halves: six to eight
-calls and checks per jump), and, from such an end, one call back to the grid at the level the
-span allows (on the grid, the calls would double from the finest level up). On an S1002
-vehicle this halves the calls (170 -> 93 per simulated second).
+Two kinds of call leave the binary grid (*free* calls): a call that ends exactly at a predicted
+contact jump (on the grid, the calls would close in on it by halves: six to eight calls and
+checks per jump), and, from such an end, one call back to the grid at the level the span allows
+(on the grid, the calls would double from the finest level up). On an S1002 vehicle this halves
+the calls (170 -> 93 per simulated second). Every call runs in the normalized time
+``tau = (t - t_a) / h``, so that one integrator serves all calls with the same output fractions
+and first-step level, whatever their length (grid calls keep seconds under a step limit
+``max_step``, which is in seconds): 32 -> 24 integrators built in the first simulated second of
+the S1002 vehicle.
 
 A continuing call starts with about IDAS's last step (GGL, :meth:`ContactStepper._first_step`),
 not 1e-3 of the call; a jump found late is redone once, to its estimated time
 (:meth:`ContactStepper._late_jump`). S1002 vehicle, rtol 1e-4: 1859 steps, 1081 Jacobian
 set-ups and 109 calls per simulated second became 1098, 534 and 89.
+
+Early jumps: a rival predicted to sink below its followed point within
+:data:`.contact_jumps.EARLY_JUMP_S`, no higher than :data:`EARLY_JUMP_ATOL` of the smallest
+absolute tolerance, is jumped to at once (:meth:`.contact_jumps.ContactCheck.target`), and a
+jump found late by no more than that height is not redone. The wheels of one side of a symmetric
+vehicle reach their jumps microseconds apart; one by one, each cost a call, a check and a
+projection. The point left is refused for twice that horizon, lest the driver jump back to it
+while it still lies below. S1002 vehicle, rtol 1e-4: 89 -> 56 calls, 1098 -> 987 steps and
+534 -> 416 Jacobian set-ups per simulated second.
 """
 from __future__ import annotations
 
@@ -36,23 +48,19 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ParameterError, SolverError
-from .contact_jumps import MIN_SPAN_S, check_contacts, jump_contacts, lost_contact
+from .contact_jumps import EARLY_JUMP_S, JUMP_TOLERANCE_M, MIN_SPAN_S, check_contacts, jump_contacts, lost_contact
 from .contact_switching import Switching
 from .failure import split_state
-from .shifted import shifted_dae
+from .shifted import CallIntegrators
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
-#: IDAS's first step relative to the call without a suggested one (first call, failure, index 1).
-INITIAL_STEP = 1e-3
 #: Largest level ``k`` of a suggested first step ``2^-k`` of the call (about 1e-3).
 FIRST_STEP_LEVELS = 10
 #: The first step of a call that continues the last one (:meth:`ContactStepper._first_step`)
 #: is rounded down to ``2^-k`` of the call with ``k`` a multiple of this: one integrator per
 #: level and grid, and building one costs about 10 ms, as much as 10 steps.
 FIRST_STEP_LEVEL_STEP = 3
-#: Integrators kept (one per call grid and linear solver; a long run meets many grids).
-MAX_INTEGRATORS = 64
 #: A jump target this deep at a call's end (m) means the jump came late: the call is redone
 #: shorter (:meth:`ContactStepper._late_jump`).
 LATE_JUMP_GAP_M = 1e-8
@@ -64,6 +72,9 @@ LATE_JUMP_MIN_FRACTION = 0.25
 RELAXED_JUMPS = 3
 #: How long (s) a jump target stays refused after IDAS failed from it (see ``advance``).
 REFUSAL_HOLD_S = 1e-3
+#: Height of an early jump's target (:data:`.contact_jumps.EARLY_JUMP_S`) as a fraction of the
+#: smallest absolute tolerance of the state: the rise it gives the wheelset is within IDAS's error.
+EARLY_JUMP_ATOL = 0.1
 #: A run stalls when this many calls fail within :data:`STALL_SPAN_S` of simulated time.
 STALL_FAILURES = 60
 STALL_SPAN_S = 1e-4
@@ -122,6 +133,8 @@ class ContactStepper:
         self.step_hint = None  # IDAS's last step in the last call (s), see _first_step
         self._start = None  # (t, x_dot) at the last call's start, see _first_step
         self.refused: dict[str, tuple[float, float]] = {}  # contact -> (wheel parameter, until t)
+        # Height (m) of an early jump's target, and depth of a late one's that is not redone.
+        self.early_m = EARLY_JUMP_ATOL * float(np.min(self._atol(len(x))))
         self._jumped_from = None  # (t, x, z, [(contact, new wheel parameter)]) of the last jump
         self.checks = check_contacts(form, x, z)
         self.span = min(min(c.span_s() for c in self.checks), self.switching.span_s(0.0, z, self.checks))
@@ -130,14 +143,13 @@ class ContactStepper:
     def set_dae(self, dae_fn) -> None:
         """Use ``dae_fn`` from now on (e.g. after a window moved)."""
         self.dae_fn = dae_fn
-        self._shifted = {}  # normalized -> shifted DAE
-        self._integrators = {}
+        self.integrators = CallIntegrators(dae_fn, self.opts)
 
     def call(self, x, z, t_a: float, h: float, inner=(), free: bool = False):
         """States at ``t_a + inner`` and at ``t_a + h``: ``(x, z)``, one column per time (one
         IDAS call; ``RuntimeError`` on failure). ``inner``: offsets (s) in ``(0, h)`` of output
         times inside the call (IDAS interpolates them: they do not limit its steps). The
-        integrator, cached per grid, solves the shifted DAE (:func:`shifted_dae`) from the
+        integrator, cached per grid, solves the shifted DAE (:func:`.shifted.shifted_dae`) from the
         DAE's own ``x_dot``; ``free``: in time normalized by ``h`` (one integrator serves
         every length: for calls off the binary grid); see :meth:`_attempts` for the
         fallbacks."""
@@ -151,9 +163,12 @@ class ContactStepper:
         for n, (solver, shifted) in enumerate(self._attempts()):
             if n:
                 self.stats["contact_fallbacks"] += 1
-            normalized = free and shifted
+            # In time normalized by the call's length, one integrator serves calls of every
+            # length with the same output fractions (a step limit in seconds would not).
+            normalized = shifted and (free or "max_step_size" not in self.opts)
             level = self._first_step_level(h, first) if shifted else None
-            integ = self._integrator([v / h for v in grid] if normalized else grid, solver, shifted, normalized, level)
+            integ = self.integrators.get([v / h for v in grid] if normalized else grid, solver, shifted, normalized,
+                                         level, h if normalized else 1.0)
             try:
                 if shifted:
                     p_ext = np.r_[p, x, x_dot, scale, h] if normalized else np.r_[p, x, x_dot, scale]
@@ -193,7 +208,7 @@ class ContactStepper:
 
     def _first_step_level(self, h: float, first: float | None) -> int | None:
         """``k`` of IDAS's first step ``h / 2^k`` in a call of length ``h`` (s): ``first``
-        (:meth:`_first_step`) rounded down to a level, else ``None`` (:data:`INITIAL_STEP`).
+        (:meth:`_first_step`) rounded down to a level, else ``None`` (:data:`.shifted.INITIAL_STEP`).
         Restarting from about 1e-3 of the call, IDAS takes ten steps, each with a Jacobian
         set-up, to double its step back up: most of the steps of a model with a hundred calls
         per simulated second. Only with GGL stabilization: index 1 leaves the position
@@ -203,30 +218,6 @@ class ContactStepper:
             return None
         k = max(0, math.ceil(math.log2(h / first) - 1e-9))
         return min(FIRST_STEP_LEVELS, FIRST_STEP_LEVEL_STEP * math.ceil(k / FIRST_STEP_LEVEL_STEP))
-
-    def _integrator(self, grid, solver: str, shifted: bool, normalized: bool = False, level: int | None = None):
-        """The integrator of the shifted DAE (or, not ``shifted``, of the DAE itself with
-        IDACalcIC) on ``grid`` with ``solver``, built on first use; ``normalized``: the shifted
-        DAE in time normalized by the call's length (``grid`` in ``(0, 1]``); IDAS's first step
-        is ``2^-level`` of the call (:meth:`_first_step_level`), :data:`INITIAL_STEP` if None."""
-        key = (solver, shifted, normalized, level) + tuple(float(f"{v:.12e}") for v in grid)  # last bits differ
-        integ = self._integrators.get(key)
-        if integ is None:
-            if shifted:
-                if normalized not in self._shifted:
-                    self._shifted[normalized] = shifted_dae(self.dae_fn, normalized)
-                # IDAS's first step would be a thousandth of the first output time (xi_dot = 0
-                # gives it no other scale): the call's length instead, so that the steps do not
-                # depend on the outputs inside the call.
-                step0 = (INITIAL_STEP if level is None else 2.0**-level) * grid[-1]
-                dae, opts = self._shifted[normalized], {**self.opts, "calc_ic": False, "step0": step0}
-            else:
-                dae, opts = self.dae_fn, self.opts
-            if len(self._integrators) >= MAX_INTEGRATORS:
-                del self._integrators[next(iter(self._integrators))]  # the oldest
-            integ = self._integrators[key] = ca.integrator("idas", "idas", dae, 0.0, grid,
-                                                           {**opts, "linear_solver": solver})
-        return integ
 
     def _atol(self, n_x: int) -> np.ndarray:
         """Absolute tolerances of the differential states."""
@@ -283,7 +274,7 @@ class ContactStepper:
         first = None
         for start, end in zip(self.checks, checks_end):
             rival = end.target(False, refused.get(end.name))
-            if rival is None or rival.point.gap_m >= -LATE_JUMP_GAP_M:
+            if rival is None or rival.point.gap_m >= -max(LATE_JUMP_GAP_M, self.early_m):
                 continue
             m1 = end.margin_m(rival)
             before = [r for r in start.rivals if start.margin_m(r) > 0]
@@ -300,15 +291,21 @@ class ContactStepper:
     def _after(self, x, z, t, relaxed=False, checks=None):
         checks = check_contacts(self.form, x, z) if checks is None else checks
         refused = {name: s1 for name, (s1, until) in self.refused.items() if t < until}
+        early = [c.name for c in checks if (r := c.target(relaxed, refused.get(c.name), self.early_m)) is not None
+                 and c.margin_m(r) >= -JUMP_TOLERANCE_M]
         x_from, z_from = x, z
         x, z, jumped = jump_contacts(self.form, x, z, t, checks, relaxed, open_rows=self.switching.open_rows(),
-                                     refused=refused)
+                                     refused=refused, early_m=self.early_m)
         self._jumped_from = None
         if jumped:
             self.stats["contact_jumps"] += len(jumped)
+            index = {e.joint.name: e.s_index for e in self.form.model.wheelrail}
+            s_from = split_state(self.form, x_from, z_from)["s"]
+            for name in early:
+                # The point left lies below the new one until the crossing: no jump back to it.
+                self.refused[name] = (float(s_from[index[name]]), t + 2 * EARLY_JUMP_S)
             if not relaxed:
                 s = split_state(self.form, x, z)["s"]
-                index = {e.joint.name: e.s_index for e in self.form.model.wheelrail}
                 self._jumped_from = (t, x_from, z_from, [(n, float(s[index[n]])) for n in jumped])
             checks = check_contacts(self.form, x, z)
         x, z, switched = self.switching.update(x, z, t, checks)

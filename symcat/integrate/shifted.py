@@ -1,5 +1,6 @@
-"""The DAE of the contact driver's integrators: the state's scaled departure from its linear
-extrapolation over a call, consistent at zero for every start (see :mod:`.contact_stepping`)."""
+"""The contact driver's integrators (see :mod:`.contact_stepping`): the DAE in the state's scaled
+departure from its linear extrapolation over a call, consistent at zero for every start, and the
+cache of integrators built on it."""
 from __future__ import annotations
 
 import casadi as ca
@@ -25,3 +26,57 @@ def shifted_dae(dae_fn: ca.Function, normalized: bool = False) -> ca.Function:
         xi_dot, quad = h * xi_dot, h * quad
     return ca.Function(f"{dae_fn.name()}_shifted", [tau, xi, z, p_ext, u], [xi_dot, alg, quad, zero],
                        dae_fn.name_in(), dae_fn.name_out())
+
+
+#: IDAS's first step relative to the call without a suggested one (first call, failure, index 1).
+INITIAL_STEP = 1e-3
+#: Integrators kept (one per call grid and linear solver; a long run meets many grids).
+MAX_INTEGRATORS = 64
+
+
+class CallIntegrators:
+    """IDAS integrators of one DAE for the contact driver's calls, built on first use (about
+    10 ms each for a compiled DAE: the Jacobian's sparsity and the linear solver's symbolic
+    factorization) and kept, the oldest dropped beyond :data:`MAX_INTEGRATORS`.
+
+    Parameters
+    ----------
+    dae_fn : casadi.Function
+        The driver's DAE ``(t, x, z, p, u) -> (ode, alg, quad, zero)``.
+    opts : dict
+        IDAS options (``max_step_size``, if any, in seconds).
+    """
+
+    def __init__(self, dae_fn: ca.Function, opts: dict):
+        self.dae_fn, self.opts = dae_fn, opts
+        self._shifted = {}  # normalized -> shifted DAE
+        self._built = {}
+
+    def get(self, grid, solver: str, shifted: bool, normalized: bool = False, level: int | None = None,
+            time_unit: float = 1.0):
+        """The integrator of the shifted DAE (or, not ``shifted``, of the DAE itself with
+        IDACalcIC) on ``grid`` with ``solver``; ``normalized``: the shifted DAE in time
+        normalized by the call's length ``time_unit`` (s; ``grid`` in ``(0, 1]``); IDAS's first
+        step is ``2^-level`` of the call, :data:`INITIAL_STEP` if None."""
+        max_step = self.opts.get("max_step_size")
+        if max_step is not None and normalized:
+            max_step = float(f"{max_step / time_unit:.12e}")  # in units of the call
+        key = (solver, shifted, normalized, level, max_step) + tuple(float(f"{v:.12e}") for v in grid)  # last bits differ
+        integ = self._built.get(key)
+        if integ is None:
+            if shifted:
+                if normalized not in self._shifted:
+                    self._shifted[normalized] = shifted_dae(self.dae_fn, normalized)
+                # IDAS's first step would be a thousandth of the first output time (xi_dot = 0
+                # gives it no other scale): the call's length instead, so that the steps do not
+                # depend on the outputs inside the call.
+                step0 = (INITIAL_STEP if level is None else 2.0**-level) * grid[-1]
+                dae, opts = self._shifted[normalized], {**self.opts, "calc_ic": False, "step0": step0}
+                if max_step is not None:
+                    opts["max_step_size"] = max_step
+            else:
+                dae, opts = self.dae_fn, self.opts
+            if len(self._built) >= MAX_INTEGRATORS:
+                del self._built[next(iter(self._built))]  # the oldest
+            integ = self._built[key] = ca.integrator("idas", "idas", dae, 0.0, grid, {**opts, "linear_solver": solver})
+        return integ

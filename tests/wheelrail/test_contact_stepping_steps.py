@@ -12,7 +12,7 @@ from symcat.integrate.contact_stepping import FIRST_STEP_LEVEL_STEP, FIRST_STEP_
 
 def _stepper(hint=None, checks=()):
     stepper = object.__new__(ContactStepper)  # the choices need no model
-    stepper.step_hint, stepper.checks, stepper.refused = hint, list(checks), {}
+    stepper.step_hint, stepper.checks, stepper.refused, stepper.early_m = hint, list(checks), {}, 0.0
     return stepper
 
 
@@ -54,3 +54,29 @@ def test_a_rival_born_inside_a_call_is_traced_back_along_its_rate():
     # A rival only nanometres below is no late jump (the next check jumps to it).
     shallow = _check(rivals=[_rival(0.001, -1e-9, rate=-1e-3)])
     assert _stepper(checks=[_check()])._late_jump([shallow], 4e-3, 0.0) is None
+
+
+@pytest.mark.parametrize("margin, rate, early_m, jumps", [
+    (5e-8, -1e-3, 1e-7, True),    # 50 nm above, crossing in 50 us: within the horizon
+    (5e-8, -1e-3, 0.0, False),    # no early jumps asked for
+    (5e-8, 1e-3, 1e-7, False),    # receding
+    (5e-7, -1e-3, 1e-6, False),   # crossing in 0.5 ms: beyond the horizon
+    (5e-7, -1e-2, 1e-7, False),   # within the horizon but higher than asked
+    (-2e-9, 0.0, 0.0, True),      # below by more than the tolerance: always
+])
+def test_a_rival_about_to_sink_below_is_jumped_to_early(margin, rate, early_m, jumps):
+    """:meth:`ContactCheck.target` with ``early_m``: a formed rival no higher than that which is
+    predicted (from the gap rates) to lie below within ``EARLY_JUMP_S`` is a target now."""
+    check = _check(gap_rate=0.0, rivals=[_rival(0.001, margin, rate=rate)])
+    assert (check.target(early_m=early_m) is not None) == jumps
+
+
+def test_a_late_jump_within_the_early_height_is_not_redone():
+    """A rival that sank below by less than the driver's early-jump height is jumped to where
+    the call ended (the wheelset rises by as much as an early jump lifts it)."""
+    end = _check(gap_rate=0.0, rivals=[_rival(0.001, -1e-6, rate=-1e-3)])
+    stepper = _stepper(checks=[_check()])
+    stepper.early_m = 2e-6
+    assert stepper._late_jump([end], 4e-3, 0.0) is None
+    stepper.early_m = 5e-7
+    assert stepper._late_jump([end], 4e-3, 0.0) == pytest.approx(3e-3)

@@ -1,9 +1,9 @@
-"""The contact driver's shifted DAE (:func:`symcat.integrate.contact_stepping.shifted_dae`): the
+"""The contact driver's shifted DAE (:func:`symcat.integrate.shifted.shifted_dae`): the
 state's scaled departure from its linear extrapolation, consistent at zero for every start."""
 import casadi as ca
 import numpy as np
 
-from symcat.integrate.contact_stepping import shifted_dae
+from symcat.integrate.shifted import CallIntegrators, shifted_dae
 
 
 def _dae():
@@ -36,3 +36,27 @@ def test_shifted_dae_starts_consistent_and_follows_the_dae():
     # A wrong start derivative (zero, as IDAS assumes without one) is not consistent.
     wrong = np.asarray(shifted(0.0, np.zeros(2), z_a, np.r_[p, x_a, 0 * x_dot, scale], ca.DM(0, 1))[0]).ravel()
     assert np.abs(wrong).max() > 1e-3
+
+
+def test_one_normalized_integrator_serves_calls_of_every_length():
+    """In normalized time the integrator depends on the output fractions and the first-step level
+    only: calls of 0.1 s and 0.4 s share it, and each matches an integration in seconds. A step
+    limit in seconds is converted to units of each call (so the integrators then differ)."""
+    dae = _dae()
+    x_a, p = np.array([0.4, -1.2]), np.array([0.7, 40.0])
+    z_a = 0.5 * x_a[0] ** 2
+    x_dot = np.asarray(dae(0.0, x_a, z_a, p, ca.DM(0, 1))[0]).ravel()
+    scale = np.array([3.0, 25.0])
+    opts = {"reltol": 1e-9, "abstol": 1e-10, "calc_ic": False, "suppress_algebraic": True}  # as the driver
+    calls = CallIntegrators(dae, opts)
+    short, long = (calls.get([0.5, 1.0], "csparse", True, True, 3, h) for h in (0.1, 0.4))
+    assert short is long
+    for h in (0.1, 0.4):
+        out = short(x0=np.zeros(2), z0=z_a, p=np.r_[p, x_a, x_dot, scale, h])
+        x_end = x_a + h * x_dot + scale * np.asarray(out["xf"])[:, -1]
+        direct = ca.integrator("i", "idas", dae, 0.0, [h], {**opts, "init_xdot": x_dot.tolist()})(x0=x_a, z0=z_a, p=p)
+        np.testing.assert_allclose(x_end, np.asarray(direct["xf"]).ravel(), rtol=0, atol=1e-7)
+    limited = CallIntegrators(dae, {**opts, "max_step_size": 0.01})
+    a, b = (limited.get([1.0], "csparse", True, True, 3, h) for h in (0.1, 0.4))
+    assert a is not b
+    assert limited.get([1.0], "csparse", True, True, 3, 0.1) is a
