@@ -6,10 +6,11 @@ Topology (each bogie, centre ``x_b``; ``x`` forward, ``y`` left, ``z`` up, rail 
   :class:`WheelRailJoint` (constraint contact, creep forces optional);
 - two **equalizer bars** (left, right) resting on the axleboxes of both wheelsets through
   journal pads: a :class:`Bushing` at each axlebox (on the axle line, so the wheelset's spin does
-  not move it) with the primary longitudinal and lateral stiffness and a stiff vertical pad;
+  not move it) with the primary longitudinal and lateral stiffness and a stiff, damped vertical
+  pad;
 - the **frame** on the equalizer bars: two vertical equalizer springs per bar (the primary
-  vertical stiffness and damping) and a guide at the bar's centre (stiff in x and y, holding its
-  roll);
+  vertical stiffness and damping) and a guide at the bar's centre (stiff and damped in x and y,
+  holding its roll);
 - the **bolster** on the frame: the secondary suspension (one bushing per side with the
   benchmark's stiffness, damping and lateral bump stop) and the anti-roll bar (torsion about x);
 - the **car body** on both bolsters by a centre plate: a :class:`Revolute` about the vertical
@@ -326,7 +327,7 @@ def _add_bogie(scene, layout, site, p, loads, bogie, xb, y0, v, dims, creep_mode
             pl = placed[ws]
             box = pl.position_m + pl.rotation[:, 1] * ys
             scene.add(Bushing(f"{bogie}_{ws}_journal_{side}", eq, f"{bogie}_{ws}", at=tuple(box),
-                              stiffness=(kx, ky, p.journal_pad_stiffness_N_m), damping=(cx, cy, 0.0),
+                              stiffness=(kx, ky, p.journal_pad_stiffness_N_m), damping=(cx, cy, p.journal_pad_damping_N_s_m),
                               preload=(0.0, 0.0, -loads["journal"]), axes=axes))
         for k, dx in enumerate((p.equalizer_spring_offset_m, -p.equalizer_spring_offset_m)):
             scene.add(Bushing(f"{bogie}_equalizer_spring_{side}_{k + 1}", eq, frame,
@@ -336,5 +337,6 @@ def _add_bogie(scene, layout, site, p, loads, bogie, xb, y0, v, dims, creep_mode
         g = p.equalizer_guide_stiffness_N_m
         scene.add(Bushing(f"{bogie}_equalizer_guide_{side}", frame, eq,
                           at=site.point((xb, y0 + ys, p.equalizer_height_m)),
-                          stiffness=(g, g, 0.0), rotational_stiffness=(p.equalizer_roll_stiffness_N_m_rad, 0.0, 0.0),
+                          stiffness=(g, g, 0.0), damping=(p.equalizer_guide_damping_N_s_m,) * 2 + (0.0,),
+                          rotational_stiffness=(p.equalizer_roll_stiffness_N_m_rad, 0.0, 0.0),
                           rotational_damping=(p.equalizer_roll_damping_N_m_s_rad, 0.0, 0.0), axes=axes))
