@@ -150,9 +150,9 @@ class ContactStepper:
         IDAS call; ``RuntimeError`` on failure). ``inner``: offsets (s) in ``(0, h)`` of output
         times inside the call (IDAS interpolates them: they do not limit its steps). The
         integrator, cached per grid, solves the shifted DAE (:func:`.shifted.shifted_dae`) from the
-        DAE's own ``x_dot``; ``free``: in time normalized by ``h`` (one integrator serves
-        every length: for calls off the binary grid); see :meth:`_attempts` for the
-        fallbacks."""
+        DAE's own ``x_dot``, in time normalized by ``h`` (one integrator serves every length;
+        in seconds for calls on the binary grid under a step limit); ``free``: a call off the
+        binary grid; see :meth:`_attempts` for the fallbacks."""
         p = np.r_[t_a, self.switching.open]
         grid = [float(v) for v in inner] + [h]
         x = np.asarray(x, float)
@@ -291,8 +291,6 @@ class ContactStepper:
     def _after(self, x, z, t, relaxed=False, checks=None):
         checks = check_contacts(self.form, x, z) if checks is None else checks
         refused = {name: s1 for name, (s1, until) in self.refused.items() if t < until}
-        early = [c.name for c in checks if (r := c.target(relaxed, refused.get(c.name), self.early_m)) is not None
-                 and c.margin_m(r) >= -JUMP_TOLERANCE_M]
         x_from, z_from = x, z
         x, z, jumped = jump_contacts(self.form, x, z, t, checks, relaxed, open_rows=self.switching.open_rows(),
                                      refused=refused, early_m=self.early_m)
@@ -301,9 +299,11 @@ class ContactStepper:
             self.stats["contact_jumps"] += len(jumped)
             index = {e.joint.name: e.s_index for e in self.form.model.wheelrail}
             s_from = split_state(self.form, x_from, z_from)["s"]
-            for name in early:
-                # The point left lies below the new one until the crossing: no jump back to it.
-                self.refused[name] = (float(s_from[index[name]]), t + 2 * EARLY_JUMP_S)
+            for c in (c for c in checks if c.name in jumped):
+                if c.margin_m(c.target(relaxed, refused.get(c.name), self.early_m)) >= -JUMP_TOLERANCE_M:
+                    # An early jump: the point left lies below the new one until the crossing,
+                    # and the driver must not jump back to it.
+                    self.refused[c.name] = (float(s_from[index[c.name]]), t + 2 * EARLY_JUMP_S)
             if not relaxed:
                 s = split_state(self.form, x, z)["s"]
                 self._jumped_from = (t, x_from, z_from, [(n, float(s[index[n]])) for n in jumped])
