@@ -10,7 +10,7 @@ Topology (each bogie, centre ``x_b``; ``x`` forward, ``y`` left, ``z`` up, rail 
   pad;
 - the **frame** on the equalizer bars: two vertical equalizer springs per bar (the primary
   vertical stiffness and damping) and a guide at the bar's centre (stiff and damped in x and y,
-  holding its roll);
+  holding its roll and its yaw: a bar free to yaw would let the wheelsets run as free ones);
 - the **bolster** on the frame: the secondary suspension (one bushing per side with the
   benchmark's stiffness, damping and lateral bump stop) and the anti-roll bar (torsion about x);
 - the **car body** on both bolsters by a centre plate: a :class:`Revolute` about the vertical
@@ -338,5 +338,7 @@ def _add_bogie(scene, layout, site, p, loads, bogie, xb, y0, v, dims, creep_mode
         scene.add(Bushing(f"{bogie}_equalizer_guide_{side}", frame, eq,
                           at=site.point((xb, y0 + ys, p.equalizer_height_m)),
                           stiffness=(g, g, 0.0), damping=(p.equalizer_guide_damping_N_s_m,) * 2 + (0.0,),
-                          rotational_stiffness=(p.equalizer_roll_stiffness_N_m_rad, 0.0, 0.0),
-                          rotational_damping=(p.equalizer_roll_damping_N_m_s_rad, 0.0, 0.0), axes=axes))
+                          rotational_stiffness=(p.equalizer_roll_stiffness_N_m_rad, 0.0,
+                                                p.equalizer_guide_yaw_stiffness_N_m_rad),
+                          rotational_damping=(p.equalizer_roll_damping_N_m_s_rad, 0.0,
+                                              p.equalizer_guide_yaw_damping_N_m_s_rad), axes=axes))

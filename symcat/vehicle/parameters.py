@@ -8,10 +8,18 @@ masses, the equalizer springs, journal pads and guides below are *plausible valu
 symcat* (marked "assumed"), sized so that the equalizer springs in series with the journal pads
 give the benchmark's primary vertical stiffness per axlebox within 6 %.
 
+The equalizer guide holds the bar's lateral position and yaw on the frame, as pedestal guides at
+its two axleboxes would: ``2 k_guide a^2`` about the vertical (``a`` the semi-wheelbase, 32.8 MN
+m/rad). With the guide at the bar's centre holding only translations, a bar yawed freely about it,
+the frame could not steer its wheelsets, and each wheelset ran as a free one: Klingel's kinematic
+oscillation (16.4 m on the conical 1:20 pair), growing at 17 m/s until the flanges struck (S1002 at
+3.3 s). Held in yaw, the bogie damps the start offset out within 2 s.
+
 The journal pads and the equalizer guides are rubber elements, damped by their hysteresis: a loss
 factor ``eta = 0.2`` at the mode each one sets, as the viscous ``c = eta k / omega``. The pads
 carry the bar's bounce near 94 Hz (``c = 0.2 * 20e6 / (2 pi 94)``, 6.8 kN s/m, taken as 7), the
-guides its lateral mode near 61 Hz (5.2 kN s/m, taken as 5). Undamped, these modes of a 120 kg
+guides its lateral mode near 61 Hz (5.2 kN s/m, taken as 5) and its yaw near 120 Hz (``0.2 *
+32.8e6 / (2 pi 120)``, 8.7 kN m s/rad, taken as 9). Undamped, these modes of a 120 kg
 bar ring at a damping ratio of 0.016 to 0.06 after every contact-point jump, and IDAS resolves
 them: on the S1002 vehicle at rtol 1e-4 this damping takes 987 steps per simulated second to 812.
 """
@@ -67,6 +75,8 @@ class VehicleParameters:
     journal_pad_damping_N_s_m: float = 7e3                        # vertical; see the note below
     equalizer_guide_stiffness_N_m: float = 10e6                   # frame to equalizer, x and y
     equalizer_guide_damping_N_s_m: float = 5e3                    # x and y; see the note below
+    equalizer_guide_yaw_stiffness_N_m_rad: float = 32.8e6        # as two guides at the axleboxes; see the note
+    equalizer_guide_yaw_damping_N_m_s_rad: float = 9e3           # see the note
     equalizer_roll_stiffness_N_m_rad: float = 1e5
     equalizer_roll_damping_N_m_s_rad: float = 1e3
 
