@@ -17,6 +17,9 @@ T_END = 1.0
 #: The reference run: a decade below the tightest row, atol 100x below its.
 REFERENCE = {"rtol": 1e-8, "atol": 1e-9}
 REPEATS = 3
+#: Steady running: the wall time per simulated second from STEADY[0] to STEADY[1] s of a run to
+#: STEADY[1] s (the run's ``output_wall_s``), once the bogies have steered the start offset out.
+STEADY = (2.0, 5.0)
 
 
 def _run(name, params):
@@ -66,6 +69,25 @@ def work_precision(profile="conical"):
     return rows
 
 
+def steady_running(profile, rtol):
+    """Wall time per simulated second from ``STEADY[0]`` to ``STEADY[1]`` s and over the whole
+    run (medians of :data:`REPEATS` runs, outputs every 20 ms), with the run's steps, calls and
+    contact jumps."""
+    parts, wholes, out = [], [], None
+    for _ in range(REPEATS):
+        try:
+            out = _run("vehicle", {"profile": profile, "t_end": STEADY[1], "n_out": int(round(50 * STEADY[1])),
+                                   "lateral_offset_m": 0.002, "rtol": rtol})
+        except SolverError as err:
+            return (profile, rtol, float("nan"), float("nan"), 0, 0, 0, str(err).split(":")[0])
+        res = out.arrays["result"]
+        i = int(np.searchsorted(res.t_s, STEADY[0] - 1e-9))
+        parts.append((res.output_wall_s[-1] - res.output_wall_s[i]) / (res.t_s[-1] - res.t_s[i]))
+        wholes.append(out.summary["wall_s"] / STEADY[1])
+    return (profile, rtol, statistics.median(parts), statistics.median(wholes), out.stats["nsteps"],
+            out.stats["contact_calls"], out.stats["contact_jumps"], "")
+
+
 def complete_scene():
     walls, out = [], None
     for _ in range(REPEATS):
@@ -79,6 +101,7 @@ def complete_scene():
 
 def section(report_dir=None) -> list[str]:
     rows = work_precision() + work_precision("s1002_uic60")
+    steady = [steady_running(p, r) for p in ("s1002_uic60", "conical") for r in (1e-4, 1e-6)]
     seo_wall, seo = complete_scene()
     return [
         "## Seed vehicle (`vehicle`) and complete scene (`seo2005`)",
@@ -92,6 +115,16 @@ def section(report_dir=None) -> list[str]:
         "| profiles | rtol | lateral error [m] | normal force error [N] | wall per simulated s | steps | calls | failure |",
         "|---|---:|---:|---:|---:|---:|---:|---|",
         *[f"| {p} | {r:g} | {e:.2e} | {en:.3g} | {w:.2f} | {s} | {c} | {f} |" for p, r, e, en, w, s, c, f in rows],
+        "",
+        f"Steady running: the same vehicle run for {STEADY[1]:g} s from the 2 mm offset (outputs every 20 ms); wall time "
+        f"per simulated second from {STEADY[0]:g} to {STEADY[1]:g} s (from the result's `output_wall_s`), once the "
+        f"bogies have steered the offset out, and over the whole run (with post-processing), medians of {REPEATS} "
+        "runs; steps, calls and contact jumps of the whole run.",
+        "",
+        f"| profiles | rtol | wall per simulated s, {STEADY[0]:g}-{STEADY[1]:g} s | wall per simulated s, 0-{STEADY[1]:g} s "
+        "| steps | calls | jumps | failure |",
+        "|---|---:|---:|---:|---:|---:|---:|---|",
+        *[f"| {p} | {r:g} | **{w:.2f}** | {wa:.2f} | {s} | {c} | {j} | {f} |" for p, r, w, wa, s, c, j, f in steady],
         "",
         f"`seo2005` (vehicle + pantograph + 8-element beam3d wire, 0.5 s at rtol 1e-6): **{seo_wall:.1f} s wall per "
         f"simulated second** (median of {REPEATS}); mean contact force {seo['contact_force_mean_N']:.1f} N.",

@@ -199,7 +199,8 @@ def run(p: dict) -> ModelOutput:
         raise SolverError(f"{err} (vehicle model: try index=ggl or a tighter rtol{hint}; a flange contact or a contact "
                           "jump may have been reached)", partial=err.partial) from err
     summary = summarize(res, layout)
-    stats = {k: res.stats[k] for k in ("nsteps", "nfevals", "netfails", "nncfails", "restarts", "contact_calls")}
+    stats = {k: res.stats[k] for k in ("nsteps", "nfevals", "nlinsetups", "netfails", "nncfails", "restarts",
+                                       "contact_calls", "contact_jumps")}
 
     def write(out):
         import matplotlib

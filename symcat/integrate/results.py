@@ -43,6 +43,9 @@ class SimulationResult:
         IDAS statistics summed over chunks, restarts, wall time.
     a : ndarray (n_t, n_q)
         Accelerations (m/s^2, 1/s^2), from the same KKT solve as the multipliers.
+    output_wall_s : ndarray (n_t,)
+        Wall time (s) from the run's start at which each output's state was known (the speed of
+        a part of the run: ``diff(output_wall_s) / diff(t_s)``).
     contacts : dict
         Penalty contact name -> ``{"s_m", "gap_m", "force_N"}`` histories (n_t,): arc length,
         normal gap (> 0 separated) and normal force.
@@ -71,6 +74,7 @@ class SimulationResult:
     velocity_drift: np.ndarray | None = None
     stats: dict = field(default_factory=dict)
     a: np.ndarray | None = None
+    output_wall_s: np.ndarray | None = None
     contacts: dict = field(default_factory=dict)
     wheelrail: dict = field(default_factory=dict)
 
@@ -88,18 +92,22 @@ class SimulationResult:
                   **{f"contact_{k}_{n}": v for k, c in self.contacts.items() for n, v in c.items()},
                   **{f"wheelrail_{k}_{n}": v for k, c in self.wheelrail.items() for n, v in c.items()},
                   **({"a": self.a} if self.a is not None else {}),
+                  **({"output_wall_s": self.output_wall_s} if self.output_wall_s is not None else {}),
                   "coordinate_names": np.array(self.coordinate_names), "row_names": np.array(self.row_names)}
         np.savez_compressed(path, **arrays)
 
 
-def collect_result(form: Formulation, t, xs, zs, stats, wall0, opens, events) -> SimulationResult:
+def collect_result(form: Formulation, t, xs, zs, stats, wall0, opens, events, walls=None) -> SimulationResult:
     model = form.model
     # Post-processing sees the whole wire: the integration windows have moved on.
     saved = [sl.window for sl in model.windowed()]
     for sl in model.windowed():
         sl.window = (0, len(sl.element_start) - 1)
     try:
-        return _collect(form, t, xs, zs, stats, wall0, opens, events)
+        res = _collect(form, t, xs, zs, stats, wall0, opens, events)
+        if walls is not None:
+            res.output_wall_s = np.asarray(walls[: len(res.t_s)], float)
+        return res
     finally:
         for sl, w in zip(model.windowed(), saved):
             sl.window = w

@@ -108,6 +108,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     if max_step:
         opts["max_step_size"] = max_step
     xs, zs = [x], [z]
+    walls = [time.perf_counter() - wall0]  # when each output was known (s)
     opens = [open_flags.copy()]  # wheel/rail contacts lifted off, at each output
     events = []                  # their lift-offs and touchdowns (contact_switching.Switch)
     stats = dict.fromkeys(STAT_KEYS, 0)
@@ -150,6 +151,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             def emit(j, x_j, z_j):
                 nonlocal done
                 xs.append(x_j)
+                walls.append(time.perf_counter() - wall0)
                 zs.append(z_j)
                 opens.append(stepper.switching.open.copy())
                 done = a + j + 1
@@ -193,6 +195,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             limit = None
             for j in range(b - a):
                 xs.append(xf[:, j])
+                walls.append(time.perf_counter() - wall0)
                 zs.append(zf[:, j])
             x, z = xf[:, -1], zf[:, -1]
             done = b
@@ -200,10 +203,10 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
             a = b
     except SolverError as err:
         bar.close()
-        err.partial = collect_result(form, t_grid[: done + 1], xs, zs, stats, wall0, opens, events)
+        err.partial = collect_result(form, t_grid[: done + 1], xs, zs, stats, wall0, opens, events, walls)
         raise
     bar.close()
-    return collect_result(form, t_grid, xs, zs, stats, wall0, opens, events)
+    return collect_result(form, t_grid, xs, zs, stats, wall0, opens, events, walls)
 
 
 def _atol_vector(form, atol) -> list:

@@ -138,4 +138,8 @@ def test_vehicle_model_runs_and_summarizes(tmp_path):
     assert 0.0 < max(s["derailment_quotient_max"]) < 0.2
     assert min(s["normal_force_min_N"]) > 0.7 * min(s["normal_force_static_N"])
     assert s["wall_s"] > 0
+    # When each output was known: from the start, in order, within the run's wall time.
+    res = r.arrays["result"]
+    assert res.output_wall_s.shape == res.t_s.shape
+    assert np.all(np.diff(res.output_wall_s) >= 0) and 0 <= res.output_wall_s[0] < res.output_wall_s[-1] <= s["wall_s"]
     assert {"vehicle.png", "vehicle.npz", "summary.json"} <= {p.name for p in tmp_path.iterdir()}
