@@ -24,7 +24,9 @@ the calls (170 -> 93 per simulated second). Every call runs in the normalized ti
 ``tau = (t - t_a) / h``, so that one integrator serves all calls with the same output fractions
 and first-step level, whatever their length (grid calls keep seconds under a step limit
 ``max_step``, which is in seconds): 32 -> 24 integrators built in the first simulated second of
-the S1002 vehicle.
+the S1002 vehicle. A call with one output inside runs in a warped time that puts the output on
+one of a few fixed fractions (:func:`.shifted.warped_grid`), so that such calls share
+integrators too.
 
 A continuing call starts with about IDAS's last step (GGL, :meth:`ContactStepper._first_step`),
 not 1e-3 of the call; a jump found late is redone once, to its estimated time
@@ -51,7 +53,7 @@ from ..errors import ParameterError, SolverError
 from .contact_jumps import EARLY_JUMP_S, JUMP_TOLERANCE_M, MIN_SPAN_S, check_contacts, jump_contacts, lost_contact
 from .contact_switching import Switching
 from .failure import split_state
-from .shifted import CallIntegrators
+from .shifted import CallIntegrators, warped_grid
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
@@ -166,12 +168,16 @@ class ContactStepper:
             # In time normalized by the call's length, one integrator serves calls of every
             # length with the same output fractions (a step limit in seconds would not).
             normalized = shifted and (free or "max_step_size" not in self.opts)
-            level = self._first_step_level(h, first) if shifted else None
-            integ = self.integrators.get([v / h for v in grid] if normalized else grid, solver, shifted, normalized,
-                                         level, h if normalized else 1.0)
+            tau_grid, warp = ([v / h for v in grid], 0.0) if normalized else (grid, 0.0)
+            if normalized and len(grid) == 2 and "max_step_size" not in self.opts:
+                # One output inside, at any fraction: a warped time puts it on a cached grid.
+                tau_grid, warp = warped_grid(grid[0] / h)
+            # The call starts at (1 + warp) times the plain time rate.
+            level = self._first_step_level(h * (1 + warp), first) if shifted else None
+            integ = self.integrators.get(tau_grid, solver, shifted, normalized, level, h if normalized else 1.0)
             try:
                 if shifted:
-                    p_ext = np.r_[p, x, x_dot, scale, h] if normalized else np.r_[p, x, x_dot, scale]
+                    p_ext = np.r_[p, x, x_dot, scale, h, warp] if normalized else np.r_[p, x, x_dot, scale]
                     out = integ(x0=np.zeros(len(x)), z0=z, p=p_ext)
                 else:
                     out = integ(x0=x, z0=z, p=p)
@@ -181,7 +187,7 @@ class ContactStepper:
             st = integ.stats()
             for k in self.stat_keys:
                 self.stats[k] += int(st.get(k, 0))
-            last = float(st.get("hlast", math.nan)) * (h if normalized else 1.0)
+            last = float(st.get("hlast", math.nan)) * (h * (1 - warp) if normalized else 1.0)  # the rate at the end
             self.step_hint = last if n == 0 and math.isfinite(last) and last > 0 else None
             xs = np.asarray(out["xf"])
             if shifted:

@@ -3,7 +3,7 @@ state's scaled departure from its linear extrapolation, consistent at zero for e
 import casadi as ca
 import numpy as np
 
-from symcat.integrate.shifted import CallIntegrators, shifted_dae
+from symcat.integrate.shifted import WARP_ANCHORS, WARP_MAX, CallIntegrators, shifted_dae, warped_grid
 
 
 def _dae():
@@ -52,7 +52,7 @@ def test_one_normalized_integrator_serves_calls_of_every_length():
     short, long = (calls.get([0.5, 1.0], "csparse", True, True, 3, h) for h in (0.1, 0.4))
     assert short is long
     for h in (0.1, 0.4):
-        out = short(x0=np.zeros(2), z0=z_a, p=np.r_[p, x_a, x_dot, scale, h])
+        out = short(x0=np.zeros(2), z0=z_a, p=np.r_[p, x_a, x_dot, scale, h, 0.0])
         x_end = x_a + h * x_dot + scale * np.asarray(out["xf"])[:, -1]
         direct = ca.integrator("i", "idas", dae, 0.0, [h], {**opts, "init_xdot": x_dot.tolist()})(x0=x_a, z0=z_a, p=p)
         np.testing.assert_allclose(x_end, np.asarray(direct["xf"]).ravel(), rtol=0, atol=1e-7)
@@ -60,3 +60,35 @@ def test_one_normalized_integrator_serves_calls_of_every_length():
     a, b = (limited.get([1.0], "csparse", True, True, 3, h) for h in (0.1, 0.4))
     assert a is not b
     assert limited.get([1.0], "csparse", True, True, 3, 0.1) is a
+
+
+def test_a_warped_call_puts_its_output_on_a_cached_grid_and_matches_the_plain_one():
+    """One output inside a call, at any fraction between 2 % and 98 %, lies on one of the warped
+    grids (``w(g) = fraction`` exactly, time monotonic); the warped integration gives the same
+    states at the output and the end as the plain one, and the same integrator serves two
+    fractions near one grid point."""
+    for fraction in np.linspace(0.02, 0.98, 97):
+        (g, end), a = warped_grid(fraction)
+        assert end == 1.0 and g in WARP_ANCHORS and abs(a) <= WARP_MAX
+        assert abs(g + a * g * (1 - g) - fraction) < 1e-15
+    assert warped_grid(0.001) == ([0.001, 1.0], 0.0)  # beyond the anchors: exact, unwarped
+    dae = _dae()
+    x_a, p = np.array([0.4, -1.2]), np.array([0.7, 40.0])
+    z_a = 0.5 * x_a[0] ** 2
+    x_dot = np.asarray(dae(0.0, x_a, z_a, p, ca.DM(0, 1))[0]).ravel()
+    scale = np.array([3.0, 25.0])
+    opts = {"reltol": 1e-9, "abstol": 1e-10, "calc_ic": False, "suppress_algebraic": True}
+    calls = CallIntegrators(dae, opts)
+    h = 0.3
+    used = set()
+    for fraction in (0.41, 0.58):
+        grid, a = warped_grid(fraction)
+        assert a != 0.0
+        warped = calls.get(grid, "csparse", True, True, 3, h)
+        used.add(id(warped))
+        out = np.asarray(warped(x0=np.zeros(2), z0=z_a, p=np.r_[p, x_a, x_dot, scale, h, a])["xf"])
+        times = np.array([fraction * h, h])
+        x_warped = x_a[:, None] + np.outer(x_dot, times) + scale[:, None] * out
+        direct = ca.integrator("i", "idas", dae, 0.0, times.tolist(), {**opts, "init_xdot": x_dot.tolist()})
+        np.testing.assert_allclose(x_warped, np.asarray(direct(x0=x_a, z0=z_a, p=p)["xf"]), rtol=0, atol=1e-7)
+    assert len(used) == 1

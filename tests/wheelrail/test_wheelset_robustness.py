@@ -286,13 +286,15 @@ def test_screened_gap_minima_equal_the_full_three_angle_search(profile, shift_m,
 
 def test_dense_output_costs_no_contact_calls():
     """The stepper's calls cross output times (IDAS interpolates them): 15 or 300 outputs (the
-    same 0.1 s spans of the driver) give the same calls and jumps, and the states at the common
-    times agree. Not bit for bit: the integrators on the two output grids differ in the last
-    bits (1e-16), which the undamped frictionless wheelset's contact jumps (plastic impacts)
-    amplify to about 2e-7 m by 0.3 s."""
+    same 0.1 s spans of the driver) give about the same calls (outputs ending calls would make
+    300) and the same jumps, and the states at the common times agree. Not bit for bit: the
+    integrators on the two output grids differ in their last bits, and a call with one output
+    inside runs in a warped time (:func:`symcat.integrate.shifted.warped_grid`) with other steps
+    within the tolerance, which the undamped frictionless wheelset's contact jumps (plastic
+    impacts) amplify to about 2e-7 m by 0.3 s (34 and 36 calls)."""
     sparse = _run(profile="s1002_uic60", creep="none", t_end=0.3, n_out=15, rtol=1e-8)
     dense = _run(profile="s1002_uic60", creep="none", t_end=0.3, n_out=300, rtol=1e-8)
-    assert dense.stats["contact_calls"] == sparse.stats["contact_calls"]
+    assert abs(dense.stats["contact_calls"] - sparse.stats["contact_calls"]) <= 0.1 * sparse.stats["contact_calls"]
     assert dense.stats["contact_jumps"] == sparse.stats["contact_jumps"] >= 1
     y_sparse, y_dense = sparse.coordinate("wheelset.y"), dense.coordinate("wheelset.y")[::20]
     np.testing.assert_allclose(y_dense, y_sparse, rtol=0, atol=1e-6)
