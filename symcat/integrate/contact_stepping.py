@@ -53,7 +53,7 @@ from ..errors import ParameterError, SolverError
 from .contact_jumps import EARLY_JUMP_S, JUMP_TOLERANCE_M, MIN_SPAN_S, check_contacts, jump_contacts, lost_contact
 from .contact_switching import Switching
 from .failure import split_state
-from .shifted import CallIntegrators, warped_grid
+from .shifted import CallIntegrators, call_grid
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
@@ -168,10 +168,7 @@ class ContactStepper:
             # In time normalized by the call's length, one integrator serves calls of every
             # length with the same output fractions (a step limit in seconds would not).
             normalized = shifted and (free or "max_step_size" not in self.opts)
-            tau_grid, warp = ([v / h for v in grid], 0.0) if normalized else (grid, 0.0)
-            if normalized and len(grid) == 2 and "max_step_size" not in self.opts:
-                # One output inside, at any fraction: a warped time puts it on a cached grid.
-                tau_grid, warp = warped_grid(grid[0] / h)
+            tau_grid, warp = call_grid(grid, h, normalized, "max_step_size" not in self.opts)
             # The call starts at (1 + warp) times the plain time rate.
             level = self._first_step_level(h * (1 + warp), first) if shifted else None
             integ = self.integrators.get(tau_grid, solver, shifted, normalized, level, h if normalized else 1.0)

@@ -55,6 +55,18 @@ def warped_grid(fraction: float) -> tuple[list[float], float]:
     return best
 
 
+def call_grid(grid, h: float, normalized: bool, warpable: bool) -> tuple[list[float], float]:
+    """``(grid, a)`` of the integrator of a call of length ``h`` (s) with outputs at ``grid``
+    (s after its start, the last its end): in seconds, or ``normalized`` by ``h``, warped
+    (:func:`warped_grid`) if there is one output inside and ``warpable`` (no step limit in
+    seconds, which a warped time would stretch)."""
+    if not normalized:
+        return list(grid), 0.0
+    if len(grid) == 2 and warpable:
+        return warped_grid(grid[0] / h)
+    return [v / h for v in grid], 0.0
+
+
 #: IDAS's first step relative to the call without a suggested one (first call, failure, index 1).
 INITIAL_STEP = 1e-3
 #: Integrators kept (one per call grid and linear solver; a long run meets many grids).
