@@ -167,8 +167,9 @@ class ContactStepper:
                 self.stats["contact_fallbacks"] += 1
             # In time normalized by the call's length, one integrator serves calls of every
             # length with the same output fractions (a step limit in seconds would not).
-            normalized = shifted and (free or "max_step_size" not in self.opts)
-            tau_grid, warp = call_grid(grid, h, normalized, "max_step_size" not in self.opts)
+            limited = "max_step_size" in self.opts
+            normalized = shifted and (free or not limited)
+            tau_grid, warp = call_grid(grid, h, normalized, not limited)
             # The call starts at (1 + warp) times the plain time rate.
             level = self._first_step_level(h * (1 + warp), first) if shifted else None
             integ = self.integrators.get(tau_grid, solver, shifted, normalized, level, h if normalized else 1.0)

@@ -45,14 +45,11 @@ def warped_grid(fraction: float) -> tuple[list[float], float]:
     least warp (``w(g) = fraction``), else the fraction itself, unwarped. An integrator is built
     per grid (10 to 15 ms for the seed vehicle, mostly CasADi deriving the Jacobian of the DAE
     anew, and a slow first call): calls that end at predicted contact jumps put their outputs at
-    any fraction, and one output in a call is the common case (S1002 vehicle, rtol 1e-6: 62 -> 41
+    any fraction, and one output in a call is the common case (S1002 vehicle, rtol 1e-6: 62 -> 44
     integrators built in the first simulated second)."""
-    best = ([fraction, 1.0], 0.0)
-    for g in WARP_ANCHORS:
-        a = (fraction - g) / (g * (1 - g))
-        if abs(a) <= WARP_MAX and (best[1] == 0.0 or abs(a) < abs(best[1])):
-            best = ([g, 1.0], a)
-    return best
+    warps = [((fraction - g) / (g * (1 - g)), g) for g in WARP_ANCHORS]
+    a, g = min(warps, key=lambda w: abs(w[0]))
+    return ([g, 1.0], a) if abs(a) <= WARP_MAX else ([fraction, 1.0], 0.0)
 
 
 def call_grid(grid, h: float, normalized: bool, warpable: bool) -> tuple[list[float], float]:
@@ -74,9 +71,9 @@ MAX_INTEGRATORS = 64
 
 
 class CallIntegrators:
-    """IDAS integrators of one DAE for the contact driver's calls, built on first use (about
-    10 ms each for a compiled DAE: the Jacobian's sparsity and the linear solver's symbolic
-    factorization) and kept, the oldest dropped beyond :data:`MAX_INTEGRATORS`.
+    """IDAS integrators of one DAE for the contact driver's calls, built on first use (10 to 15
+    ms each for the compiled seed vehicle, two thirds of it CasADi deriving the DAE's Jacobian
+    anew, the rest the linear solver's set-up) and kept, the oldest dropped beyond :data:`MAX_INTEGRATORS`.
 
     Parameters
     ----------
