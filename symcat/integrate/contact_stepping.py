@@ -29,8 +29,8 @@ one of a few fixed fractions (:func:`.shifted.warped_grid`), so that such calls 
 integrators too.
 
 A continuing call starts with about IDAS's last step (GGL, :meth:`ContactStepper._first_step`),
-not 1e-3 of the call; a jump found late is redone once, to its estimated time
-(:meth:`ContactStepper._late_jump`). S1002 vehicle, rtol 1e-4: 1859 steps, 1081 Jacobian
+not 1e-3 of the call; a jump found late is redone once, to its estimated time, from the
+call's last output before it if there is one (:mod:`.late_jumps`). S1002 vehicle, rtol 1e-4: 1859 steps, 1081 Jacobian
 set-ups and 109 calls per simulated second became 1098, 534 and 89.
 
 Early jumps: a rival predicted to sink below its followed point within
@@ -52,7 +52,8 @@ import numpy as np
 from ..errors import ParameterError, SolverError
 from .contact_jumps import EARLY_JUMP_S, JUMP_TOLERANCE_M, MIN_SPAN_S, check_contacts, jump_contacts, lost_contact
 from .contact_switching import Switching
-from .failure import split_state
+from .failure import split_state, stall_reason, sweep_hint
+from .late_jumps import LATE_JUMP_EARLY, kept_output, late_jump_time
 from .shifted import CallIntegrators, call_grid
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
@@ -63,13 +64,9 @@ FIRST_STEP_LEVELS = 10
 #: is rounded down to ``2^-k`` of the call with ``k`` a multiple of this: one integrator per
 #: level and grid, and building one costs about 10 ms, as much as 10 steps.
 FIRST_STEP_LEVEL_STEP = 3
-#: A jump target this deep at a call's end (m) means the jump came late: the call is redone
-#: shorter (:meth:`ContactStepper._late_jump`).
-LATE_JUMP_GAP_M = 1e-8
-#: A late jump's call is redone to this fraction of the estimated crossing (the rival then above).
-LATE_JUMP_EARLY = 0.9
-#: Least fraction of a call that a late jump's redo keeps (:meth:`ContactStepper._late_jump`).
-LATE_JUMP_MIN_FRACTION = 0.25
+#: Longest call (s) that falls back to other linear solvers or IDACalcIC when IDAS fails
+#: (:meth:`ContactStepper._attempts`).
+FALLBACK_SPAN_S = 1e-3
 #: Relaxed jumps tried after consecutive failed calls from one state.
 RELAXED_JUMPS = 3
 #: How long (s) a jump target stays refused after IDAS failed from it (see ``advance``).
@@ -80,9 +77,6 @@ EARLY_JUMP_ATOL = 0.1
 #: A run stalls when this many calls fail within :data:`STALL_SPAN_S` of simulated time.
 STALL_FAILURES = 60
 STALL_SPAN_S = 1e-4
-#: A failure while a contact point moves faster than this along its wheel profile (m/s) is
-#: reported with it (:meth:`ContactStepper._sweep_hint`).
-SWEEP_HINT_M_S = 5.0
 
 
 class CallFailed(RuntimeError):
@@ -110,7 +104,8 @@ class ContactStepper:
         ``contact_calls``, ``contact_retries``, ``contact_fallbacks``, ``contact_refusals``,
         ``lift_offs``, ``touchdowns``, ``switch_redos`` and ``jump_redos`` (calls redone up to
         a switch or a contact jump they passed unpredicted,
-        :meth:`.contact_switching.Switching.overshoot`, :meth:`_late_jump`).
+        :meth:`.contact_switching.Switching.overshoot`, :meth:`_late_jump`), of which
+        ``jump_redos_kept`` were kept up to an output inside them (:meth:`_kept_output`).
     open_flags : ndarray, optional
         Contacts open at the start (:func:`.contact_switching.initial_open`); default none.
     """
@@ -120,7 +115,7 @@ class ContactStepper:
         self.stats = stats
         self.stat_keys = stat_keys
         for key in ("contact_jumps", "contact_calls", "contact_retries", "contact_fallbacks", "contact_refusals",
-                    "lift_offs", "touchdowns", "switch_redos", "jump_redos"):
+                    "lift_offs", "touchdowns", "switch_redos", "jump_redos", "jump_redos_kept"):
             stats.setdefault(key, 0)
         self.switching = Switching(form, np.zeros(len(form.model.wheelrail)) if open_flags is None else open_flags)
         # IDAS's own messages on calls the driver retries would only alarm (failures it cannot
@@ -162,7 +157,7 @@ class ContactStepper:
         scale = 1.0 + self.opts["reltol"] * np.abs(x) / self._atol(len(x))
         first = self._first_step(t_a, x, x_dot)
         exc = None
-        for n, (solver, shifted) in enumerate(self._attempts()):
+        for n, (solver, shifted) in enumerate(self._attempts(h)):
             if n:
                 self.stats["contact_fallbacks"] += 1
             # In time normalized by the call's length, one integrator serves calls of every
@@ -229,68 +224,30 @@ class ContactStepper:
             return np.asarray(self.opts["abstolv"][:n_x], float)
         return np.full(n_x, float(self.opts.get("abstol", 1e-8)))
 
-    def _attempts(self):
-        """``(linear solver, shifted)`` to try in turn. IDAS's first steps of a microsecond call
-        have ``cj = 1/h`` near 1e7, where the QR solver of the GGL form has failed on consistent
-        states that LU integrates; IDACalcIC (not shifted) last: its Newton matrix is singular
-        with GGL's position rows (they hold no algebraic unknown) and it may fail on a state
-        consistent to the tolerance."""
+    def _attempts(self, h: float):
+        """``(linear solver, shifted)`` to try in turn for a call of ``h`` seconds. IDAS's first
+        steps of a microsecond call have ``cj = 1/h`` near 1e7, where the QR solver of the GGL
+        form has failed on consistent states that LU integrates; IDACalcIC (not shifted) last:
+        its Newton matrix is singular with GGL's position rows (they hold no algebraic unknown)
+        and it may fail on a state consistent to the tolerance. The fallbacks rescue calls that
+        cannot start; a call longer than :data:`FALLBACK_SPAN_S` gets none: it fails mostly at
+        a fold met on the way (a contact point vanishing with a rival born inside the call),
+        which every fallback meets again after as many steps (S1002 vehicle: one 0.1 s call
+        cost 1.1 s in three attempts), and the driver's shorter retry, checked first, either
+        starts or is short enough for them."""
         solver = self.opts.get("linear_solver")
+        if h > FALLBACK_SPAN_S:
+            return [(solver, True)]
         return [(solver, True), ("csparse", True), (solver, False)]
 
-    def _stall_reason(self, exc) -> str:
-        flat = min(self.checks, key=lambda c: c.curvature_per_m)
-        last = str(exc).strip().splitlines()[-1] if str(exc).strip() else repr(exc)
-        return (f"{STALL_FAILURES} integrator calls failed within {STALL_SPAN_S:g} s of simulated time "
-                f"(last: {last.strip('. ')}); the flattest contact is {flat.name}, relative curvature "
-                f"{flat.curvature_per_m:.3g} 1/m with {len(flat.rivals)} other minima of the gap: nearly "
-                "conformal wheel and rail, where one constraint point per wheel is ill-conditioned (another "
-                "n_out or rtol moves the call boundaries; profiles with more curvature difference avoid it)")
-
-    def _sweep_hint(self) -> str:
-        """Why the contact points may defeat IDAS, if one sweeps: the fastest along its wheel
-        profile when that exceeds :data:`SWEEP_HINT_M_S` (its rate grows as the relative
-        curvature shrinks: nearly conformal profiles, e.g. the flange root of S1002 on the
-        gauge corner of UIC60, crossed without creep damping)."""
-        fast = max(self.checks, key=lambda c: abs(c.s_rate[0]))
-        rate = abs(float(fast.s_rate[0]))
-        if rate < SWEEP_HINT_M_S:
-            return ""
-        return (f" (the {fast.name} contact point was sweeping along its wheel at {rate:.3g} m/s, relative curvature "
-                f"{fast.curvature_per_m:.3g} 1/m: nearly conformal wheel and rail, which one constraint point per "
-                "wheel follows only as fast as IDAS converges; creep forces damp such sweeps)")
-
     def _late_jump(self, checks_end, h: float, t: float) -> float | None:
-        """Time (s after the call's start) at which a rival sank below the followed point, if at
-        the call's end one lies deeper than :data:`LATE_JUMP_GAP_M`: the jump is then redone at
-        about that time. The rates' linear prediction (:meth:`ContactCheck.span_s`) misses a
-        rival that speeds up or is born inside the call; a late jump lifts the wheelset (GGL
-        projects onto the deeper point: energy gained) or leaves it penetrating (index 1).
-
-        The time is the secant zero of the rival's margin between the call's ends if a rival
-        lay above the followed point at the start (the nearest along the wheel), else the
-        margin's zero extrapolated back from its end rate (a rival born inside the call), else
-        half the call; at least :data:`LATE_JUMP_MIN_FRACTION` of it, so that the redone calls
-        close in geometrically where the estimate fails (at a rail's kink the point past the
-        crease appears with the crossing: an estimate near the start would advance the run by
-        microseconds per call)."""
+        """:func:`.late_jumps.late_jump_time` of a call of ``h`` seconds from ``t``."""
         refused = {name: s1 for name, (s1, until) in self.refused.items() if t + h < until}
-        first = None
-        for start, end in zip(self.checks, checks_end):
-            rival = end.target(False, refused.get(end.name))
-            if rival is None or rival.point.gap_m >= -max(LATE_JUMP_GAP_M, self.early_m):
-                continue
-            m1 = end.margin_m(rival)
-            before = [r for r in start.rivals if start.margin_m(r) > 0]
-            f = 0.5
-            if before:
-                m0 = start.margin_m(min(before, key=lambda r: abs(r.point.s[0] - rival.point.s[0])))
-                f = m0 / (m0 - m1)
-            elif rival.gap_rate_m_s < end.gap_rate_m_s:
-                f = max(0.0, 1.0 + m1 / ((end.gap_rate_m_s - rival.gap_rate_m_s) * h))
-            f = min(max(f, LATE_JUMP_MIN_FRACTION), 1.0)
-            first = f * h if first is None else min(first, f * h)
-        return first
+        return late_jump_time(self.checks, checks_end, h, refused, self.early_m)
+
+    def _kept_output(self, t: float, offsets, xs, zs, before: float):
+        """:func:`.late_jumps.kept_output` of a call from ``t`` that passed a contact jump."""
+        return kept_output(lambda x, z: check_contacts(self.form, x, z), self._late_jump, t, offsets, xs, zs, before)
 
     def _after(self, x, z, t, relaxed=False, checks=None):
         checks = check_contacts(self.form, x, z) if checks is None else checks
@@ -379,6 +336,7 @@ class ContactStepper:
         failures = 0
         stall_t, stalled = t0, 0
         emitted = 0
+        redo_end = -math.inf  # end (s) of a redone call kept up to an output (see _kept_output)
         while pos < end:
             pos_b, free = self._next_end(pos, end, k_max, dt)
             t = t0 + dt * pos / end
@@ -396,7 +354,7 @@ class ContactStepper:
                     stall_t, stalled = t, 0
                 stalled += 1
                 if stalled > STALL_FAILURES:
-                    raise CallFailed(t, x, z, RuntimeError(self._stall_reason(exc))) from None
+                    raise CallFailed(t, x, z, RuntimeError(stall_reason(self.checks, exc, STALL_FAILURES, STALL_SPAN_S))) from None
                 if self._jumped_from is not None and self._jumped_from[0] == t:
                     _, x, z, targets = self._jumped_from
                     for name, s1 in targets:
@@ -408,7 +366,7 @@ class ContactStepper:
                 if jumped:
                     continue
                 if h <= shortest:
-                    raise CallFailed(t, x, z, RuntimeError(f"{exc}{self._sweep_hint()}")) from None
+                    raise CallFailed(t, x, z, RuntimeError(f"{exc}{sweep_hint(self.checks)}")) from None
                 self.span, self.event = h / 4, math.inf
                 continue
             except (SolverError, ParameterError) as exc:
@@ -429,15 +387,31 @@ class ContactStepper:
                 if t_late is not None:
                     # A rival sank below the followed point unpredicted: redo up to before it.
                     self.stats["jump_redos"] += 1
-                    # A free call to just before it (the rival, then above, is predicted).
+                    # A free call to just before it (the rival, then above, is predicted),
+                    # from the last output inside the call before it if there is one.
                     self.span = self.event = max(LATE_JUMP_EARLY * t_late, MIN_SPAN_S)
-                    continue
+                    kept = self._kept_output(t, [times[j] - t for j in inside], xs_new, zs_new, self.span)
+                    if kept is None:
+                        continue
+                    self.stats["jump_redos_kept"] += 1
+                    col, checks_col = kept
+                    for c in range(col):
+                        if emit is not None:
+                            emit(inside[c], xs_new[:, c], zs_new[:, c])
+                    j = inside[col]
+                    emitted, redo_end = j, t + self.span
+                    pos_b, t_b = (times[j] - t0) / dt * end, float(times[j])
+                    xs_new, zs_new, checks_end, inside = xs_new[:, : col + 1], zs_new[:, : col + 1], checks_col, []
             pos = pos_b
             for col, j in enumerate(inside):
                 if emit is not None:
                     emit(j, xs_new[:, col], zs_new[:, col])
             emitted += len(inside)
             x, z, _ = self._after(xs_new[:, -1], zs_new[:, -1], t_b, checks=checks_end)
+            if redo_end - t_b > MIN_SPAN_S:
+                # Kept up to an output before a late jump: on to the redo's end, as from the start.
+                self.span, self.event = min(self.span, redo_end - t_b), min(self.event, redo_end - t_b)
+            redo_end = -math.inf
             # A call ending on an output time emits the state after the contact check (jumps).
             while emitted < len(times) and abs(times[emitted] - t_b) <= 1e-12 * max(1.0, abs(t_b)):
                 if emit is not None:

@@ -1,5 +1,6 @@
 """The contact driver's choices between calls (:class:`symcat.integrate.contact_stepping.ContactStepper`):
-IDAS's first step in a call that continues the last one, and the time a late jump is redone at."""
+IDAS's first step in a call that continues the last one, the time a late jump is redone at and
+the output its call is kept up to, and the fallbacks of a failed call."""
 import math
 from types import SimpleNamespace
 
@@ -7,7 +8,7 @@ import numpy as np
 import pytest
 
 from symcat.integrate.contact_jumps import ContactCheck, Rival
-from symcat.integrate.contact_stepping import FIRST_STEP_LEVEL_STEP, FIRST_STEP_LEVELS, ContactStepper
+from symcat.integrate.contact_stepping import FALLBACK_SPAN_S, FIRST_STEP_LEVEL_STEP, FIRST_STEP_LEVELS, ContactStepper
 
 
 def _stepper(hint=None, checks=()):
@@ -80,3 +81,32 @@ def test_a_late_jump_within_the_early_height_is_not_redone():
     assert stepper._late_jump([end], 4e-3, 0.0) is None
     stepper.early_m = 5e-7
     assert stepper._late_jump([end], 4e-3, 0.0) == pytest.approx(3e-3)
+
+
+def test_only_short_calls_fall_back_to_other_solvers():
+    """A call that fails falls back to LU and to IDACalcIC only when it is short (a failure to
+    start); a long one fails mostly at a fold met on the way, which every fallback would meet
+    again after as many steps."""
+    stepper = _stepper()
+    stepper.opts = {"linear_solver": "qr"}
+    assert stepper._attempts(2 * FALLBACK_SPAN_S) == [("qr", True)]
+    assert stepper._attempts(FALLBACK_SPAN_S) == [("qr", True), ("csparse", True), ("qr", False)]
+
+
+def test_a_late_jump_keeps_the_call_up_to_its_last_output_before_the_crossing(monkeypatch):
+    """The output kept is the last one no later than the redo's end, if no rival lies below
+    there by more than a late jump's depth; else none (the call is redone from its start)."""
+    import symcat.integrate.contact_stepping as stepping
+
+    states = {1.0: _check(), 2.0: _check(), 3.0: _check(rivals=[_rival(0.001, -1e-6)])}
+    monkeypatch.setattr(stepping, "check_contacts", lambda form, x, z: [states[float(x[0])]])
+    stepper = _stepper(checks=[_check()])
+    stepper.form = None
+    xs = np.array([[1.0, 2.0, 3.0]])
+    offsets = [1e-3, 2e-3, 3e-3]
+    assert stepper._kept_output(0.0, offsets, xs, xs, 2.5e-3)[0] == 1
+    assert stepper._kept_output(0.0, offsets, xs, xs, 0.5e-3) is None
+    states[2.0] = _check(rivals=[_rival(0.001, -1e-6)])  # already below at the kept output
+    assert stepper._kept_output(0.0, offsets, xs, xs, 2.5e-3) is None
+    states[2.0] = _check(rivals=[_rival(0.001, -1e-9)])  # nanometres below: the next check jumps
+    assert stepper._kept_output(0.0, offsets, xs, xs, 2.5e-3)[0] == 1

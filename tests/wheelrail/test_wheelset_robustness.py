@@ -313,3 +313,20 @@ def test_a_frictionless_sweep_over_the_conformal_flange_root_is_reported():
                                           r"at \d+ m/s, relative curvature 0\.\d+ 1/m") as err:
         _run(profile="s1002_uic60", creep="none", lateral_offset_m=0.007, t_end=0.05, n_out=10)
     assert err.value.partial is not None and len(err.value.partial.t_s) >= 2
+
+
+def test_a_late_jump_kept_up_to_an_output_matches_the_call_redone_from_its_start(monkeypatch):
+    """A call that passed a contact jump unpredicted is kept up to its last output before the
+    crossing (:meth:`ContactStepper._kept_output`) instead of redone from its start: the same
+    jumps, no more IDAS steps, and the lateral motion within 5 um of the redone run's (rtol
+    1e-6; both jump at an estimated crossing, the kept run from IDAS's interpolated state)."""
+    from symcat.integrate.contact_stepping import ContactStepper
+
+    params = dict(profile="s1002_uic60", creep="linear", lateral_offset_m=0.002, t_end=1.0, n_out=50, rtol=1e-6)
+    kept = _run(**params)
+    monkeypatch.setattr(ContactStepper, "_kept_output", lambda self, *args: None)
+    redone = _run(**params)
+    assert kept.stats["jump_redos_kept"] >= 1 and redone.stats["jump_redos_kept"] == 0
+    assert kept.stats["contact_jumps"] == redone.stats["contact_jumps"] >= 1
+    assert kept.stats["nsteps"] <= redone.stats["nsteps"]
+    np.testing.assert_allclose(kept.coordinate("wheelset.y"), redone.coordinate("wheelset.y"), rtol=0, atol=5e-6)
