@@ -345,7 +345,8 @@ class ContactStepper:
             # Output times strictly inside the call (those within rounding of its end are its end).
             inside = [j for j in range(emitted, len(times) - 1) if times[j] < t_b - 1e-12 * max(1.0, abs(t_b))]
             try:
-                xs_new, zs_new = self.call(x, z, t, h, [times[j] - t for j in inside], free)
+                inner = [times[j] - t for j in inside]
+                xs_new, zs_new = self.call(x, z, t, h, inner, free)
             except RuntimeError as exc:
                 self.step_hint = None
                 self.stats["contact_retries"] += 1
@@ -374,7 +375,7 @@ class ContactStepper:
             self.stats["contact_calls"] += 1
             failures = 0
             if h > shortest:
-                offsets = [times[j] - t for j in inside] + [h]
+                offsets = inner + [h]
                 t_switch = self.switching.overshoot(z, self.checks, offsets, xs_new, zs_new)
                 if t_switch is not None:
                     # A switch passed unpredicted: redo the call up to just before it.
@@ -390,7 +391,7 @@ class ContactStepper:
                     # A free call to just before it (the rival, then above, is predicted),
                     # from the last output inside the call before it if there is one.
                     self.span = self.event = max(LATE_JUMP_EARLY * t_late, MIN_SPAN_S)
-                    kept = self._kept_output(t, [times[j] - t for j in inside], xs_new, zs_new, self.span)
+                    kept = self._kept_output(t, inner, xs_new, zs_new, self.span)
                     if kept is None:
                         continue
                     self.stats["jump_redos_kept"] += 1
@@ -400,7 +401,7 @@ class ContactStepper:
                             emit(inside[c], xs_new[:, c], zs_new[:, c])
                     j = inside[col]
                     emitted, redo_end = j, t + self.span
-                    pos_b, t_b = (times[j] - t0) / dt * end, float(times[j])
+                    pos_b, t_b = (times[j] - t0) / dt * end, float(times[j])  # the output's own time
                     xs_new, zs_new, checks_end, inside = xs_new[:, : col + 1], zs_new[:, : col + 1], checks_col, []
             pos = pos_b
             for col, j in enumerate(inside):
