@@ -282,8 +282,8 @@ class ContactStepper:
         return x, z, jumped + [s.name for s in switched]
 
     def _next_end(self, pos, end: int, k_max: int, dt: float):
-        """``(end position, free)`` of the next call from ``pos`` (an integer, in units of
-        ``dt / end``, see :meth:`advance`). On the binary grid: ``dt / 2^k``, the longest not
+        """``(end position, free)`` of the next call from ``pos`` (in units of ``dt / end``, see
+        :meth:`advance`; an integer, but for an output time a call was kept up to). On the binary grid: ``dt / 2^k``, the longest not
         beyond the span, from a multiple of it (one integrator per grid serves all such calls).
         A predicted jump (:meth:`.contact_jumps.ContactCheck.event_s`) that binds the span is
         called to exactly (a free call, :meth:`call`), where calls on the grid would close in on
@@ -336,12 +336,12 @@ class ContactStepper:
         failures = 0
         stall_t, stalled = t0, 0
         emitted = 0
-        redo_end = -math.inf  # end (s) of a redone call kept up to an output (see _kept_output)
         while pos < end:
             pos_b, free = self._next_end(pos, end, k_max, dt)
             t = t0 + dt * pos / end
             t_b = t0 + dt * pos_b / end
             h = t_b - t
+            redo_end = -math.inf  # end (s) of a late jump's redo if the call is kept up to an output
             # Output times strictly inside the call (those within rounding of its end are its end).
             inside = [j for j in range(emitted, len(times) - 1) if times[j] < t_b - 1e-12 * max(1.0, abs(t_b))]
             try:
@@ -355,7 +355,8 @@ class ContactStepper:
                     stall_t, stalled = t, 0
                 stalled += 1
                 if stalled > STALL_FAILURES:
-                    raise CallFailed(t, x, z, RuntimeError(stall_reason(self.checks, exc, STALL_FAILURES, STALL_SPAN_S))) from None
+                    reason = stall_reason(self.checks, exc, STALL_FAILURES, STALL_SPAN_S)
+                    raise CallFailed(t, x, z, RuntimeError(reason)) from None
                 if self._jumped_from is not None and self._jumped_from[0] == t:
                     _, x, z, targets = self._jumped_from
                     for name, s1 in targets:
@@ -412,7 +413,6 @@ class ContactStepper:
             if redo_end - t_b > MIN_SPAN_S:
                 # Kept up to an output before a late jump: on to the redo's end, as from the start.
                 self.span, self.event = min(self.span, redo_end - t_b), min(self.event, redo_end - t_b)
-            redo_end = -math.inf
             # A call ending on an output time emits the state after the contact check (jumps).
             while emitted < len(times) and abs(times[emitted] - t_b) <= 1e-12 * max(1.0, abs(t_b)):
                 if emit is not None:
