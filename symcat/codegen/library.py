@@ -81,7 +81,18 @@ def compile_c(c_path: Path, name: str, flags: tuple = CFLAGS, key_source: bytes 
     target = cached_library(name, c_path.read_bytes() if key_source is None else key_source, flags)
     if target.exists():
         return target
-    compiler = find_compiler()
+    build_library(find_compiler(), flags, c_path, target)
+    return target
+
+
+def build_library(compiler: str, flags: tuple, c_path: Path, target: Path) -> None:
+    """Compile ``c_path`` with ``flags`` into ``target``, installed whole (:func:`os.replace`).
+
+    Raises
+    ------
+    CompilerError
+        If the compiler cannot run or fails (with its command and the end of its messages).
+    """
     target.parent.mkdir(parents=True, exist_ok=True)
     tmp = target.with_name(f".{target.name}.{os.getpid()}.{time.monotonic_ns()}.tmp")
     cmd = [compiler, *flags, str(c_path), "-o", str(tmp), "-lm"]
@@ -97,7 +108,6 @@ def compile_c(c_path: Path, name: str, flags: tuple = CFLAGS, key_source: bytes 
         tail = "\n".join(proc.stderr.strip().splitlines()[-15:])
         raise CompilerError(f"compiling {c_path} failed (exit {proc.returncode}): {' '.join(cmd)}\n{tail}")
     os.replace(tmp, target)
-    return target
 
 
 @dataclass

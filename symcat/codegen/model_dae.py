@@ -19,27 +19,30 @@ from typing import Callable
 
 import casadi as ca
 
-from .library import cached_library, compile_c, merged, symbolic_kernels
+from .library import build_library, cached_library, find_compiler, merged, symbolic_kernels
+from .optimized import OPTIMIZED_FLAGS, optimize_mode, source_path, start_background
+from .paths import atomic_write
 
 log = logging.getLogger(__name__)
 
-#: The code is straight-line arithmetic at -O0. -O1 makes the vehicle's 5.4 MB of code 2.6
-#: times smaller and its Jacobian twice as fast with cold caches (0.8 ms), but compiles for 40 s
-#: (plain) to over 2 min (after :func:`_merged`): register allocation over 200k operations.
+#: The code is straight-line arithmetic, compiled at -O0 first (11 s for the seed vehicle's 5 MB),
+#: then optimized in the background (:mod:`.optimized`: twice as fast, 27 s to compile).
 FLAGS = ("-O0", "-fPIC", "-shared")
 
 #: What the library's code is, beyond the graph, in its cache key (merged subexpressions).
 LAYOUT = b"|cse"
 
-#: Compilations of this process (the tests check that a second run makes none).
+#: Models generated and compiled by this process (the tests check that a second run makes none;
+#: the seconds exclude the background compilers).
 COMPILED = {"n": 0, "seconds": 0.0}
 
 
 def compiled_dae(build: Callable[[], ca.Function]) -> ca.Function:
     """The DAE function that ``build`` returns (an MX function over the kernels), as a compiled
-    external with its Jacobian companion ``jac_<name>``: same inputs, outputs and values.
+    external with its Jacobian companion ``jac_<name>``: same inputs, outputs and values. The
+    library is the optimized one (:mod:`.optimized`) once there, else the -O0 one.
 
-    ``build`` is called once as is (its serialization is the cache key) and, if the model is
+    ``build`` is called once as is (its serialization is the cache key) and, if the library is
     not in the cache yet, once inside :func:`symbolic_kernels`: it must obtain every kernel
     through :func:`symcat.codegen.library.kernel_library` while it runs.
 
@@ -48,40 +51,72 @@ def compiled_dae(build: Callable[[], ca.Function]) -> ca.Function:
     RuntimeError
         If the graph cannot be expanded to SX (a kernel captured as an external outside
         ``build``); the caller then keeps the MX function.
+    ParameterError
+        If ``$SYMCAT_OPTIMIZE`` is not one of :data:`.optimized.MODES`.
     """
     fn = build()
+    return ca.external(fn.name(), str(model_library(build, fn)))
+
+
+def model_library(build: Callable[[], ca.Function], fn: ca.Function, mode: str | None = None) -> Path:
+    """Path of the compiled library of the DAE ``fn = build()`` (see :func:`compiled_dae`),
+    compiling what ``mode`` (default: ``$SYMCAT_OPTIMIZE``, :mod:`.optimized`) asks for."""
+    mode = optimize_mode() if mode is None else mode
     name = fn.name()
     # The graph over the externals names each kernel library by its content-addressed path:
     # its serialization identifies the model without deriving anything.
     key = fn.serialize().encode() + LAYOUT
-    library = cached_library(f"model_{name}", key, FLAGS)
-    if not library.exists():
+    plain = cached_library(f"model_{name}", key, FLAGS)
+    optimized = cached_library(f"model_{name}", key, OPTIMIZED_FLAGS)
+    if mode != "off" and optimized.exists():
+        return optimized
+    target, flags = (optimized, OPTIMIZED_FLAGS) if mode == "now" else (plain, FLAGS)
+    if not target.exists():
         t0 = time.perf_counter()
-        with symbolic_kernels():
-            sx = build().expand()
-        if any(sx.instruction_id(k) == ca.OP_CALL for k in range(sx.n_instructions())):
-            # A kernel captured as an external before `build` ran: the C code would call a
-            # symbol no library defines.
-            raise RuntimeError(f"the DAE {name!r} calls compiled kernels that do not expand to SX")
-        # Merged subexpressions (the expanded kernels repeat each other's work). The seed
-        # vehicle: residual 63k -> 43k operations, Jacobian 222k -> 167k; the -O0 library 7.2
-        # -> 5.4 MB, compiled in 10 s instead of 17 s; with cold caches, as IDAS meets it, the
-        # Jacobian takes 1.1 ms instead of 1.8 ms and the residual 0.45 ms instead of 0.64 ms.
-        sx = merged(sx)
-        jac = merged(sx.jacobian())
-        log.info("compiling the model's DAE (%d operations) and its Jacobian (%d)", sx.n_instructions(),
-                 jac.n_instructions())
         with tempfile.TemporaryDirectory() as tmp:
-            cwd = os.getcwd()
-            os.chdir(tmp)  # CasADi writes relative to the working directory
-            try:
-                gen = ca.CodeGenerator(f"model_{name}.c", {"with_header": False, "verbose": False})
-                gen.add(sx)
-                gen.add(jac)
-                gen.generate()
-            finally:
-                os.chdir(cwd)
-            compile_c(Path(tmp) / f"model_{name}.c", f"model_{name}", FLAGS, key_source=key)
+            c_path = write_dae_c(build, name, Path(tmp))
+            if mode == "now":
+                log.info("compiling the model's DAE optimized (about 30 s for the seed vehicle)")
+            build_library(find_compiler(), flags, c_path, target)
+            if mode == "background" and not optimized.exists():
+                atomic_write(source_path(optimized), c_path.read_bytes())
         COMPILED["n"] += 1
         COMPILED["seconds"] += time.perf_counter() - t0
-    return ca.external(name, str(library))
+    if mode == "background" and source_path(optimized).exists():  # also a job that died
+        start_background(optimized)
+    return target
+
+
+def write_dae_c(build: Callable[[], ca.Function], name: str, folder: Path) -> Path:
+    """Generate the C of the DAE ``build()`` (named ``name``) and of its Jacobian into ``folder``
+    (expanded over the kernels' SX and differentiated, subexpressions merged); its path.
+
+    Raises
+    ------
+    RuntimeError
+        If the graph calls a compiled kernel that does not expand (see :func:`compiled_dae`).
+    """
+    with symbolic_kernels():
+        sx = build().expand()
+    if any(sx.instruction_id(k) == ca.OP_CALL for k in range(sx.n_instructions())):
+        # A kernel captured as an external before `build` ran: the C code would call a
+        # symbol no library defines.
+        raise RuntimeError(f"the DAE {name!r} calls compiled kernels that do not expand to SX")
+    # Merged subexpressions (the expanded kernels repeat each other's work). The seed
+    # vehicle: residual 63k -> 43k operations, Jacobian 222k -> 167k; the -O0 library 7.2
+    # -> 5.4 MB, compiled in 10 s instead of 17 s; with cold caches, as IDAS meets it, the
+    # Jacobian takes 1.1 ms instead of 1.8 ms and the residual 0.45 ms instead of 0.64 ms.
+    sx = merged(sx)
+    jac = merged(sx.jacobian())
+    log.info("compiling the model's DAE (%d operations) and its Jacobian (%d)", sx.n_instructions(),
+             jac.n_instructions())
+    cwd = os.getcwd()
+    os.chdir(folder)  # CasADi writes relative to the working directory
+    try:
+        gen = ca.CodeGenerator(f"model_{name}.c", {"with_header": False, "verbose": False})
+        gen.add(sx)
+        gen.add(jac)
+        gen.generate()
+    finally:
+        os.chdir(cwd)
+    return folder / f"model_{name}.c"

@@ -1,0 +1,119 @@
+"""The optimized tier of the model DAE libraries (symcat.codegen.optimized): compiled in the
+background after the -O0 library, loaded by later runs, equal in value; compiled at once in
+mode ``now``; never in mode ``off``; a dead compiler's job restarted, a failed one reported."""
+import subprocess
+import sys
+
+import casadi as ca
+import numpy as np
+import pytest
+
+import symcat.codegen.model_dae as model_dae
+from symcat.codegen import optimized
+from symcat.codegen.library import cached_library
+from symcat.dae.formulation import Formulation
+from symcat.dae.initial import consistent_state
+from symcat.errors import ParameterError
+
+from .test_model_dae import _wheelset
+
+
+@pytest.fixture
+def form():
+    return Formulation(_wheelset("conical", "linear"), "augmented", "ggl", 10.0, False)
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    """Model libraries in a folder of their own (the kernels stay in the shared cache)."""
+    monkeypatch.setattr(model_dae, "cached_library",
+                        lambda name, key, flags: tmp_path / cached_library(name, key, flags).name)
+    return tmp_path
+
+
+def _libraries(folder):
+    return sorted(p.name for p in folder.iterdir() if p.suffix == ".so")
+
+
+def _values(library, form, seed):
+    """Residual and Jacobian of the compiled DAE at perturbed consistent states."""
+    fn = ca.external(form.dae_function().name(), str(library))
+    jac = fn.jacobian()
+    x, z = consistent_state(form, 0.0)
+    rng, out = np.random.default_rng(seed), []
+    for k in range(2):
+        args = [0.01, x + 1e-4 * rng.standard_normal(len(x)) * k, z, np.zeros(fn.size1_in(3)), ca.DM(0, 1)]
+        out += [np.asarray(ca.densify(v)) for v in fn(*args)[:2]]
+        out += [np.asarray(ca.densify(v)) for v in jac(*args, *[ca.DM.zeros(fn.sparsity_out(i)) for i in range(4)])]
+    return [v for v in out if v.size]
+
+
+def test_background_compile_is_loaded_by_the_next_run_and_equals_the_plain_library(form, cache):
+    first = model_dae.model_library(form.dae_function, form.dae_function(), "background")
+    assert first.suffix == ".so" and first.exists()
+    # The C waits in the cache for the compiler started in the background.
+    waiting = sorted(cache.glob("*.c"))
+    assert len(waiting) == 1
+    assert optimized.wait_for_background(300.0)
+    assert not list(cache.glob("*.c")) and not list(cache.glob("*.lock")) and not list(cache.glob("*.failed"))
+    libs = _libraries(cache)
+    assert len(libs) == 2 and first.name in libs
+    optimized_lib = cache / next(n for n in libs if n != first.name)
+    assert optimized_lib == waiting[0].with_suffix(".so")
+    before = model_dae.COMPILED["n"]
+    second = model_dae.model_library(form.dae_function, form.dae_function(), "background")
+    assert second == optimized_lib and model_dae.COMPILED["n"] == before
+    # Same arithmetic, in registers instead of on the stack: equal to rounding.
+    for a, b in zip(_values(first, form, 7), _values(second, form, 7)):
+        assert np.allclose(a, b, rtol=1e-12, atol=1e-12 * (1 + np.abs(a).max()))
+    # Mode off keeps to the plain library even where the optimized one exists.
+    assert model_dae.model_library(form.dae_function, form.dae_function(), "off") == first
+
+
+def test_mode_now_compiles_the_optimized_library_at_once_and_off_never_does(form, cache):
+    now = model_dae.model_library(form.dae_function, form.dae_function(), "now")
+    assert _libraries(cache) == [now.name] and not list(cache.glob("*.c"))
+    for p in cache.iterdir():
+        p.unlink()
+    off = model_dae.model_library(form.dae_function, form.dae_function(), "off")
+    assert off != now and _libraries(cache) == [off.name]
+    assert not list(cache.glob("*.c")) and not list(cache.glob("*.lock"))
+    assert optimized.wait_for_background(0.0)
+
+
+def test_a_dead_compilers_job_is_started_again_and_a_live_one_is_not(form, cache):
+    plain = model_dae.model_library(form.dae_function, form.dae_function(), "off")
+    # The C left by a run whose background compiler died (its lock names a dead process).
+    target = model_dae.cached_library(f"model_{form.dae_function().name()}",
+                                      form.dae_function().serialize().encode() + model_dae.LAYOUT,
+                                      optimized.OPTIMIZED_FLAGS)
+    with model_dae.tempfile.TemporaryDirectory() as tmp:
+        c_path = model_dae.write_dae_c(form.dae_function, form.dae_function().name(), model_dae.Path(tmp))
+        optimized.source_path(target).write_bytes(c_path.read_bytes())
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    target.with_suffix(".lock").write_text(str(dead.pid))
+    assert model_dae.model_library(form.dae_function, form.dae_function(), "background") == plain
+    assert target.with_suffix(".lock").read_text() != str(dead.pid)  # a new job holds it
+    assert not optimized.start_background(target)  # while it runs, no second one
+    assert optimized.wait_for_background(300.0)
+    assert target.exists() and not optimized.source_path(target).exists()
+
+
+def test_a_failed_compile_is_reported_in_a_file_and_not_retried(tmp_path):
+    target = tmp_path / "model_broken-0123.so"
+    optimized.source_path(target).write_text("this is not C;\n")
+    assert optimized.start_background(target)
+    assert optimized.wait_for_background(120.0)
+    failed = target.with_suffix(".failed")
+    assert failed.exists() and "CompilerError" in failed.read_text()
+    assert not target.exists() and not optimized.source_path(target).exists()
+    assert not target.with_suffix(".lock").exists()
+
+
+def test_an_unknown_mode_is_refused_with_its_name(monkeypatch):
+    monkeypatch.setenv("SYMCAT_OPTIMIZE", "fast")
+    with pytest.raises(ParameterError, match="SYMCAT_OPTIMIZE='fast'.*background, now, off"):
+        optimized.optimize_mode()
+    monkeypatch.setenv("SYMCAT_OPTIMIZE", " Now ")
+    assert optimized.optimize_mode() == "now"
