@@ -29,6 +29,7 @@ from ..scene.wheelrail import WheelRailJoint
 from ..scene.scene import Scene
 from .sparse import MatrixScatter, to_casadi_sparse, vector_scatter
 from .system import System
+from ..wheelrail.identity_memo import IdentityMemo
 
 import scipy.sparse as sps
 
@@ -106,6 +107,10 @@ class MultibodyModel:
         self.sliding: list[Sliding] = []
         self.contacts: list[Sliding] = []   # penalty contacts (same window bookkeeping)
         self.wheelrail: list = []           # wheel/rail contacts (symcat.assembly.wheelrail)
+        # Functions the wheel/rail contacts share (one per profile or creep model; in the model,
+        # not the process, so that the graph, whose serialization keys the compiled DAE, does not
+        # depend on what was built before).
+        self.wheelrail_shared = IdentityMemo()
         self.row_names: list[str] = []
         for body in scene.rigid_bodies:
             self._add("normalization_rigid", body.name, [Side("rigid", self._rigid_indices(body.name), body)], {})

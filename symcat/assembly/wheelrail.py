@@ -32,6 +32,7 @@ length); tangent track keeps the cheaper ``wheelrail_*_rigid_ground`` kernels.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -47,6 +48,7 @@ from ..scene.rigid import RigidBody
 from ..scene.wheelrail import CreepModel, WheelRailJoint
 from ..wheelrail.creep import SHEAR_MODULUS_STEEL_PA, kalker_coefficients, kalker_linear_forces
 from ..wheelrail.hertz import hertz_contact, relative_curvatures
+from ..wheelrail.identity_memo import IdentityMemo
 from ..wheelrail.track_pieces import interval_lookup
 
 #: Rows of a contact that define its surface parameters in the embedded form (eq. 22: the two
@@ -92,12 +94,16 @@ class WheelRailEntry:
     row_start: int = 0              # first of its 5 constraint rows
 
 
-def piece_lookup(profile, name: str) -> ca.Function:
+def piece_lookup(profile, name: str, shared: IdentityMemo | None = None) -> ca.Function:
     """Compiled SX lookup ``s -> [s0, y_0:4, z_0:4]`` of the cubic piece containing ``s``
-    (the end pieces extend beyond the profile's ends)."""
-    pp = profile.piecewise_polynomial()
-    rows = np.column_stack([pp.x[:-1], pp.c[:, :, 0].T, pp.c[:, :, 1].T])
-    return interval_lookup(pp.x, rows, name)
+    (the end pieces extend beyond the profile's ends); with ``shared``, one per profile object,
+    named ``name`` by the first contact that asks."""
+    def build():
+        pp = profile.piecewise_polynomial()
+        rows = np.column_stack([pp.x[:-1], pp.c[:, :, 0].T, pp.c[:, :, 1].T])
+        return interval_lookup(pp.x, rows, name)
+
+    return build() if shared is None else shared.get((profile,), ("piece",), build)
 
 
 def add_wheelrail(model, joint: WheelRailJoint) -> WheelRailEntry:
@@ -121,14 +127,14 @@ def add_wheelrail(model, joint: WheelRailJoint) -> WheelRailEntry:
     s0 = point.s
     head = contact.parameters(s0)[:6]
     entry = WheelRailEntry(joint, contact, contact.library, body, rows, s0, head,
-                           piece_lookup(joint.wheel, f"{joint.name}_wheel_piece"),
-                           piece_lookup(joint.rail, f"{joint.name}_rail_piece"))
+                           piece_lookup(joint.wheel, f"{joint.name}_wheel_piece", model.wheelrail_shared),
+                           piece_lookup(joint.rail, f"{joint.name}_rail_piece", model.wheelrail_shared))
     if contact.curved:
         entry.track_piece = contact.frames.lookup(f"{joint.name}_track_piece")
     entry.normal_fn = rail_normal_function(f"{joint.name}_normal", curved=contact.curved)
     if joint.creep is not None:
         entry.creep = creep_setup(joint, contact, point)
-        entry.creep_fn = creep_function(joint, entry.creep, curved=contact.curved)
+        entry.creep_fn = creep_function(joint, entry.creep, curved=contact.curved, shared=model.wheelrail_shared)
     return entry
 
 
@@ -259,10 +265,20 @@ def rail_normal_function(name: str, curved: bool = False) -> ca.Function:
     return ca.Function(name, [s, p], [_contact_frame(p, s, curved)[2]], ["s", "p"], ["n"])
 
 
-def creep_function(joint: WheelRailJoint, setup: CreepSetup, curved: bool = False) -> ca.Function:
+def creep_function(joint: WheelRailJoint, setup: CreepSetup, curved: bool = False,
+                   shared: IdentityMemo | None = None) -> ca.Function:
     """SX function ``(x, x_dot, s, p, N) -> (Q, [xi_x, xi_y, phi, Fx, Fy, Mz])``: generalized creep
     forces on the wheelset coordinates ``x = [R, theta]`` (7) for surface parameters ``s``,
-    kernel parameters ``p`` (24; 46 on curved track) and normal force ``N`` (N)."""
+    kernel parameters ``p`` (24; 46 on curved track) and normal force ``N`` (N). It depends on
+    the creep model alone (the profiles enter through ``p``): with ``shared``, contacts with
+    equal creep models share one, named by the first."""
+    if shared is None:
+        return _creep_function(joint, setup, curved)
+    values = (dataclasses.astuple(joint.creep), float(setup.nominal_normal_force_N), bool(curved), "creep")
+    return shared.get((), values, lambda: _creep_function(joint, setup, curved))
+
+
+def _creep_function(joint: WheelRailJoint, setup: CreepSetup, curved: bool) -> ca.Function:
     x, xd = ca.SX.sym("x", 7), ca.SX.sym("xd", 7)
     s, p, normal = ca.SX.sym("s", 4), ca.SX.sym("p", 46 if curved else 24), ca.SX.sym("N")
     side, r0, b = p[0], p[1], p[2]

@@ -12,6 +12,7 @@ from symcat.errors import ParameterError, SolverError
 
 from .constraint_contact import ContactPoint, WheelRailContact
 from .geometry import TrackCrossSection, WheelsetDimensions, contact_geometry
+from .identity_memo import IdentityMemo
 from .track import TrackLayout
 from .track_pieces import cross_section_of
 
@@ -37,6 +38,11 @@ class WheelsetPlacement:
     roll_rad: float
     yaw_rad: float
     contacts: dict
+
+
+#: The 2D rest geometry (:func:`contact_geometry`) per profile pair, shift, cross-section and
+#: wheelset: a vehicle's four wheelsets start from the same (20 ms each).
+_REST_2D = IdentityMemo(8)
 
 
 def _rot_x(a):
@@ -96,7 +102,8 @@ def wheelset_on_track(wheel, rail, lateral_shift_m: float = 0.0, *, x_m: float =
     else:
         cross = track or TrackCrossSection()
         centre, axes = np.array([float(x_m), 0.0, 0.0]), _rot_x(cant_rad)
-    geo = contact_geometry(wheel, rail, [lateral_shift_m], track=cross, wheelset=wheelset, roll=True)
+    geo = _REST_2D.get((wheel, rail), (float(lateral_shift_m), cross, wheelset),
+                       lambda: contact_geometry(wheel, rail, [lateral_shift_m], track=cross, wheelset=wheelset, roll=True))
     contacts = {side: WheelRailContact(wheel, rail, side, wheelset=wheelset, track=track, cant_rad=cant_rad,
                                        track_piece_length_m=track_piece_length_m)
                 for side in ("left", "right")}

@@ -143,3 +143,44 @@ def test_vehicle_model_runs_and_summarizes(tmp_path):
     assert res.output_wall_s.shape == res.t_s.shape
     assert np.all(np.diff(res.output_wall_s) >= 0) and 0 <= res.output_wall_s[0] < res.output_wall_s[-1] <= s["wall_s"]
     assert {"vehicle.png", "vehicle.npz", "summary.json"} <= {p.name for p in tmp_path.iterdir()}
+
+
+def _vehicle_model(profile="conical"):
+    scene = Scene(gravity=(0.0, 0.0, -G))
+    add_vehicle(scene, profile_pair(profile, 0.05), speed_ms=17.0, creep="linear", lateral_offset_m=0.002)
+    return MultibodyModel(scene)
+
+
+def test_wheels_share_lookups_and_creep_function_and_the_model_key_does_not_depend_on_history():
+    """The eight wheels of one profile pair and creep model share their profile look-ups and
+    creep function (built once per model), and the DAE graph, whose serialization keys the
+    compiled library, is the same whether or not another model was built before it."""
+    from symcat.dae.formulation import Formulation
+
+    first = _vehicle_model()
+    entries = first.wheelrail
+    assert len(entries) == 8
+    for attr in ("wheel_piece", "rail_piece", "creep_fn"):
+        assert len({id(getattr(e, attr)) for e in entries}) == 1, attr
+    key = Formulation(first, "augmented", "ggl").dae_function().serialize()
+    _vehicle_model("s1002_uic60")  # another pair in between
+    again = _vehicle_model()
+    assert entries[0].creep_fn is not again.wheelrail[0].creep_fn  # per model, not per process
+    assert Formulation(again, "augmented", "ggl").dae_function().serialize() == key
+
+
+def test_identity_memo_keys_on_identity_and_values_and_drops_the_oldest():
+    from symcat.wheelrail.identity_memo import IdentityMemo
+
+    memo, built = IdentityMemo(size=2), []
+    a, b = [1.0], [1.0]  # equal, not the same
+
+    def make(tag):
+        return lambda: built.append(tag) or tag
+
+    assert memo.get((a,), (1,), make("a1")) == "a1"
+    assert memo.get((a,), (1,), make("again")) == "a1"
+    assert memo.get((b,), (1,), make("b1")) == "b1"
+    assert memo.get((a,), (2,), make("a2")) == "a2"
+    assert len(memo) == 2 and memo.get((a,), (1,), make("a1 rebuilt")) == "a1 rebuilt"
+    assert built == ["a1", "b1", "a2", "a1 rebuilt"]
