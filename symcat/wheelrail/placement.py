@@ -103,7 +103,8 @@ def wheelset_on_track(wheel, rail, lateral_shift_m: float = 0.0, *, x_m: float =
         cross = track or TrackCrossSection()
         centre, axes = np.array([float(x_m), 0.0, 0.0]), _rot_x(cant_rad)
     geo = _REST_2D.get((wheel, rail), (float(lateral_shift_m), cross, wheelset),
-                       lambda: contact_geometry(wheel, rail, [lateral_shift_m], track=cross, wheelset=wheelset, roll=True))
+                       lambda: contact_geometry(wheel, rail, [lateral_shift_m], track=cross, wheelset=wheelset,
+                                                roll=True))
     contacts = {side: WheelRailContact(wheel, rail, side, wheelset=wheelset, track=track, cant_rad=cant_rad,
                                        track_piece_length_m=track_piece_length_m)
                 for side in ("left", "right")}
