@@ -94,7 +94,8 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     # body keeps its given position and velocity and s follows it.
     w_inv = sps.diags(np.r_[np.ones(n_f), np.full(form.n_s, 1e6)])
     if closed.size:
-        c, jac, *_ = evaluate(q, v, s, w)
+        terms = evaluate(q, v, s, w)
+        c, jac = terms[:2]
         _check_rank(jac, names)
         scale = 1.0 + np.abs(np.r_[q, s]).max(initial=0.0)
         for _ in range(max_iterations):
@@ -102,14 +103,15 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
                 break
             u = np.r_[q, s] - w_inv @ (jac.T @ _solve(jac @ w_inv @ jac.T, c))
             q, s = u[:n_f], u[n_f:]
-            c, jac, *_ = evaluate(q, v, s, w)
+            terms = evaluate(q, v, s, w)
+            c, jac = terms[:2]
         else:
             worst = int(np.argmax(np.abs(c)))
             raise SolverError(
                 f"initial conditions cannot be made consistent: after {max_iterations} projections the "
                 f"constraint {names[worst]} is still violated by {c[worst]:.3g}; check the joint positions"
             )
-        c, jac, ct, _, m, _, cq, cs = evaluate(q, v, s, w)
+        c, jac, ct, _, m, _, cq, cs = terms  # at the final q, s (the velocities have not moved yet)
         if impulse:
             dv, w, _ = kkt_solve(m, np.zeros(n_f), cq, cs, cq @ v + ct)
             v = v + dv

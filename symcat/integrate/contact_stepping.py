@@ -44,6 +44,8 @@ while it still lies below. S1002 vehicle, rtol 1e-4: 89 -> 56 calls, 1098 -> 987
 """
 from __future__ import annotations
 
+import contextlib
+import io
 import math
 
 import casadi as ca
@@ -128,6 +130,7 @@ class ContactStepper:
         self.opts["max_num_steps"] = min(int(opts.get("max_num_steps", MAX_CALL_STEPS)), MAX_CALL_STEPS)
         self.set_dae(dae_fn)
         self.step_hint = None  # IDAS's last step in the last call (s), see _first_step
+        self.idas_said: list[str] = []  # IDAS's last message on a failed call
         self._start = None  # (t, x_dot) at the last call's start, see _first_step
         self.refused: dict[str, tuple[float, float]] = {}  # contact -> (wheel parameter, until t)
         # Height (m) of an early jump's target, and depth of a late one's that is not redone.
@@ -168,15 +171,19 @@ class ContactStepper:
             # The call starts at (1 + warp) times the plain time rate.
             level = self._first_step_level(h * (1 + warp), first) if shifted else None
             integ = self.integrators.get(tau_grid, solver, shifted, normalized, level, h if normalized else 1.0)
-            try:
-                if shifted:
-                    p_ext = np.r_[p, x, x_dot, scale, h, warp] if normalized else np.r_[p, x, x_dot, scale]
-                    out = integ(x0=np.zeros(len(x)), z0=z, p=p_ext)
-                else:
-                    out = integ(x0=x, z0=z, p=p)
-            except RuntimeError as err:
-                exc = exc or err  # the first attempt's reason: the fallbacks' are consequences
-                continue
+            # IDAS prints its errors (through CasADi, to sys.stderr): the driver retries failed
+            # calls, so a message is kept for the report of a failure the driver cannot recover.
+            with contextlib.redirect_stderr(io.StringIO()) as said:
+                try:
+                    if shifted:
+                        p_ext = np.r_[p, x, x_dot, scale, h, warp] if normalized else np.r_[p, x, x_dot, scale]
+                        out = integ(x0=np.zeros(len(x)), z0=z, p=p_ext)
+                    else:
+                        out = integ(x0=x, z0=z, p=p)
+                except RuntimeError as err:
+                    if exc is None:  # the first attempt's reason: the fallbacks' are consequences
+                        exc, self.idas_said = err, said.getvalue().strip().splitlines()[-1:]
+                    continue
             st = integ.stats()
             for k in self.stat_keys:
                 self.stats[k] += int(st.get(k, 0))
@@ -368,7 +375,8 @@ class ContactStepper:
                 if jumped:
                     continue
                 if h <= shortest:
-                    raise CallFailed(t, x, z, RuntimeError(f"{exc}{sweep_hint(self.checks)}")) from None
+                    said = f" (IDAS: {self.idas_said[0]})" if self.idas_said else ""
+                    raise CallFailed(t, x, z, RuntimeError(f"{exc}{said}{sweep_hint(self.checks)}")) from None
                 self.span, self.event = h / 4, math.inf
                 continue
             except (SolverError, ParameterError) as exc:

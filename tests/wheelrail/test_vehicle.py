@@ -213,3 +213,14 @@ def test_a_looser_velocity_tolerance_avoids_the_creep_modes_error_test_failures(
 def test_bad_velocity_tolerance_is_refused_with_its_name(velocity_atol):
     with pytest.raises(ParameterError, match="velocity_atol"):
         simulate(_vehicle_model(), 0.01, index="ggl", velocity_atol=velocity_atol, progress=False)
+
+
+def test_idas_messages_on_retried_calls_stay_quiet_and_a_final_failure_reports_one(capsys):
+    """The contact driver retries failed calls, so IDAS's own messages (printed through CasADi
+    to stderr) are not shown; a failure it cannot recover from (here: three steps allowed per
+    call) names IDAS's message of that call in its report."""
+    from symcat.errors import SolverError
+
+    with pytest.raises(SolverError, match=r"\(IDAS: At t = .*\)"):
+        simulate(_vehicle_model(), 0.01, index="ggl", max_steps=3, progress=False)
+    assert capsys.readouterr().err == ""
