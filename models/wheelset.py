@@ -74,6 +74,11 @@ PARAMETERS = [
     Parameter("formulation", "augmented", "", "equations of motion: seed eq. 25 or 26",
               choices=("augmented", "embedded")),
     Parameter("rtol", 1e-6, "-", "IDAS relative tolerance", minimum=0.0, maximum=0.1, exclusive_minimum=True),
+    Parameter("atol", 0.0, "m", "IDAS absolute tolerance of positions (m, rad); 0: rtol/100 (1e-8 at the default "
+              "rtol; a fixed 1e-8 made IDAS fail half its error tests at rtol 1e-4 and 1e-5)", minimum=0.0,
+              maximum=0.1),
+    Parameter("atol_velocity", 0.0, "m/s", "IDAS absolute tolerance of the velocities (m/s, rad/s); 0: 10 x atol "
+              "(positions accurate to atol over motions up to 10 rad/s)", minimum=0.0, maximum=1.0),
     Parameter("n_out", 400, "-", "output intervals", minimum=10, maximum=100000),
     Parameter("irregularity_file", "", "", "CSV of measured track irregularities: header s_m (from the start, m) and "
               "any of alignment_m, level_m, cross_level_m, gauge_m (m); empty: ideal track"),
@@ -153,7 +158,9 @@ def klingel_wavelength(pair, placed, dims=None) -> float:
 def run(p: dict) -> ModelOutput:
     scene, model, placed, pair = build(p)
     try:
-        res = simulate(model, p["t_end"], formulation=p["formulation"], rtol=p["rtol"], n_out=int(p["n_out"]),
+        atol = p.get("atol") or 0.01 * p["rtol"]
+        res = simulate(model, p["t_end"], formulation=p["formulation"], rtol=p["rtol"], atol=atol,
+                       velocity_atol=p.get("atol_velocity") or 10.0 * atol, n_out=int(p["n_out"]),
                        progress=p.get("progress", True))
     except SolverError as err:
         raise SolverError(f"{err} (wheelset model: one constraint contact point per wheel, which jumps to the "
