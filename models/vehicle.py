@@ -57,6 +57,7 @@ import numpy as np
 from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError, SolverError
 from symcat.integrate import simulate
+from symcat.integrate.simulate import VELOCITY_ATOL_FACTOR
 from symcat.model import Model, ModelOutput, Parameter
 from symcat.scene import Scene
 from symcat.vehicle import (DRIVES, VehicleParameters, add_vehicle, curve_track, lateral_displacement_m,
@@ -65,8 +66,6 @@ from symcat.wheelrail import PAIR_NAMES, profile_pair
 from symcat.wheelrail.track import Tangent, TrackLayout, rail_offset_for, read_irregularities
 
 G = 9.81
-#: The velocities' absolute tolerance (m/s, rad/s) as a multiple of the positions' (m, rad) by default.
-VELOCITY_ATOL_FACTOR = 10.0
 
 PARAMETERS = [
     Parameter("profile", "s1002_uic60", "", "wheel/rail profiles", choices=PAIR_NAMES),

@@ -48,6 +48,7 @@ import numpy as np
 from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError, SolverError
 from symcat.integrate import simulate
+from symcat.integrate.simulate import VELOCITY_ATOL_FACTOR
 from symcat.model import Model, ModelOutput, Parameter
 from symcat.scene import CreepModel, Driving, PointLoad, RigidBody, Scene, WheelRailJoint
 from symcat.wheelrail import PAIR_NAMES, WheelsetDimensions, profile_pair, wheelset_on_track
@@ -160,7 +161,7 @@ def run(p: dict) -> ModelOutput:
     try:
         atol = p.get("atol") or 0.01 * p["rtol"]
         res = simulate(model, p["t_end"], formulation=p["formulation"], rtol=p["rtol"], atol=atol,
-                       velocity_atol=p.get("atol_velocity") or 10.0 * atol, n_out=int(p["n_out"]),
+                       velocity_atol=p.get("atol_velocity") or VELOCITY_ATOL_FACTOR * atol, n_out=int(p["n_out"]),
                        progress=p.get("progress", True))
     except SolverError as err:
         raise SolverError(f"{err} (wheelset model: one constraint contact point per wheel, which jumps to the "

@@ -33,6 +33,11 @@ CONTACT_GROUP_S = 0.1
 
 STAT_KEYS = ("nsteps", "nfevals", "nlinsetups", "netfails", "nniters", "nncfails")
 
+#: The models' default velocity tolerance (m/s, rad/s) as a multiple of their position tolerance
+#: (m, rad): positions accurate to atol over motions up to 10 rad/s (``simulate``'s own default
+#: is ``atol`` itself).
+VELOCITY_ATOL_FACTOR = 10.0
+
 
 def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented", index: str = "1",
              rtol: float = 1e-6, atol: float = 1e-8, n_out: int = 200, baumgarte: float = 10.0,
@@ -222,24 +227,23 @@ def _atol_vector(form, atol, velocity_atol=None) -> list:
     (``velocity_atol`` for the velocities, default ``atol``)."""
     xb, _ = form.blocks()
     n_x = sum(b.size for b in xb.values())
-    out = np.empty(n_x)
-    for name, value in (("atol", atol), ("velocity_atol", atol if velocity_atol is None else velocity_atol)):
-        per = np.atleast_1d(np.asarray(value, dtype=float))
-        if per.size not in (1, form.model.n_q):
-            raise ParameterError(f"{name}: give a number or {form.model.n_q} values (one per coordinate), "
-                                 f"not {per.size}")
-        if not np.all(np.isfinite(per) & (per > 0)):
-            raise ParameterError(f"{name}={value!r}: must be > 0 (m, rad; m/s, rad/s for the velocities)")
-        if per.size == 1:
-            free = np.full(xb["q"].size, float(per[0]))
-        else:
-            free = per[form.model.free] if not form.cholesky else np.full(form.n_f, per.min())
-        if name == "atol":
-            out[:] = per.min()  # the other differential states (surface parameters, ...)
-            out[xb["q"].slice] = free
-        else:
-            out[xb["v"].slice] = free
+    q_atol = _free_atol(form, "atol", atol)
+    out = np.full(n_x, float(np.min(atol)))  # the other differential states (surface parameters, ...)
+    out[xb["q"].slice] = q_atol
+    out[xb["v"].slice] = q_atol if velocity_atol is None else _free_atol(form, "velocity_atol", velocity_atol)
     return out.tolist()
+
+
+def _free_atol(form, name: str, value) -> np.ndarray:
+    """Tolerance ``value`` (a number or one per generalized coordinate) on the free coordinates."""
+    per = np.atleast_1d(np.asarray(value, dtype=float))
+    if per.size not in (1, form.model.n_q):
+        raise ParameterError(f"{name}: give a number or {form.model.n_q} values (one per coordinate), not {per.size}")
+    if not np.all(np.isfinite(per) & (per > 0)):
+        raise ParameterError(f"{name}={value!r}: must be > 0 (m, rad; m/s, rad/s for the velocities)")
+    if per.size == 1:
+        return np.full(form.n_f, float(per[0]))
+    return per[form.model.free] if not form.cholesky else np.full(form.n_f, per.min())
 
 
 def _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges) -> int:
