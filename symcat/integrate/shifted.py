@@ -43,8 +43,8 @@ def warped_grid(fraction: float) -> tuple[list[float], float]:
     """``(grid, a)``: the normalized grid and warp (:func:`shifted_dae`) of a call with one output
     inside, at ``fraction`` of its length: the grid point of :data:`WARP_ANCHORS` that needs the
     least warp (``w(g) = fraction``), else the fraction itself, unwarped. An integrator is built
-    per grid (10 to 15 ms for the seed vehicle, mostly CasADi deriving the Jacobian of the DAE
-    anew, and a slow first call): calls that end at predicted contact jumps put their outputs at
+    per grid (about 2 ms for the seed vehicle with :class:`SharedDerivatives`, 10 to 15 ms when
+    CasADi derived the DAE's Jacobian anew for each): calls that end at predicted contact jumps put their outputs at
     any fraction, and one output in a call is the common case (S1002 vehicle, rtol 1e-6: 62 -> 44
     integrators built in the first simulated second)."""
     warps = [((fraction - g) / (g * (1 - g)), g) for g in WARP_ANCHORS]
@@ -64,6 +64,55 @@ def call_grid(grid, h: float, normalized: bool, warpable: bool) -> tuple[list[fl
     return [v / h for v in grid], 0.0
 
 
+class SharedDerivatives(ca.Callback):
+    """``fn`` as an integrator's DAE whose derived functions are built once for every
+    integrator: CasADi builds an IDAS integrator's residual and Jacobian functions (``daeF``,
+    ``jacF``) through the DAE's ``factory``, deriving the Jacobian of its graph anew for each
+    integrator (6 of the 9 ms of a build for the seed vehicle), which this DAE answers from
+    its cache (a build then takes about 2 ms). The integrators evaluate only what the factory
+    returned; :meth:`eval` (through Python) serves any other caller.
+
+    Parameters
+    ----------
+    fn : casadi.Function
+        The DAE ``(t, x, z, p, u) -> (ode, alg, quad, zero)``.
+    """
+
+    def __init__(self, fn: ca.Function):
+        ca.Callback.__init__(self)
+        self.fn = fn
+        self.derived = {}  # (name, inputs, outputs, aux, options) -> Function
+        self.construct(f"{fn.name()}_shared", {})
+
+    def get_n_in(self):
+        return self.fn.n_in()
+
+    def get_n_out(self):
+        return self.fn.n_out()
+
+    def get_sparsity_in(self, i):
+        return self.fn.sparsity_in(i)
+
+    def get_sparsity_out(self, i):
+        return self.fn.sparsity_out(i)
+
+    def get_name_in(self, i):
+        return self.fn.name_in(i)
+
+    def get_name_out(self, i):
+        return self.fn.name_out(i)
+
+    def eval(self, arg):
+        return self.fn.call(arg)
+
+    def get_factory(self, name, s_in, s_out, aux, opts):
+        key = (name, tuple(s_in), tuple(s_out), repr(aux), repr(opts))
+        derived = self.derived.get(key)
+        if derived is None:
+            derived = self.derived[key] = self.fn.factory(name, s_in, s_out, aux, opts)
+        return derived
+
+
 #: IDAS's first step relative to the call without a suggested one (first call, failure, index 1).
 INITIAL_STEP = 1e-3
 #: Integrators kept (one per call grid and linear solver; a long run meets many grids).
@@ -71,9 +120,10 @@ MAX_INTEGRATORS = 64
 
 
 class CallIntegrators:
-    """IDAS integrators of one DAE for the contact driver's calls, built on first use (10 to 15
-    ms each for the compiled seed vehicle, two thirds of it CasADi deriving the DAE's Jacobian
-    anew, the rest the linear solver's set-up) and kept, the oldest dropped beyond :data:`MAX_INTEGRATORS`.
+    """IDAS integrators of one DAE for the contact driver's calls, built on first use over one
+    :class:`SharedDerivatives` per DAE variant (about 2 ms each for the compiled seed vehicle,
+    mostly the linear solver's set-up; 9 ms when each derived the DAE's Jacobian anew) and kept,
+    the oldest dropped beyond :data:`MAX_INTEGRATORS`.
 
     Parameters
     ----------
@@ -85,7 +135,8 @@ class CallIntegrators:
 
     def __init__(self, dae_fn: ca.Function, opts: dict):
         self.dae_fn, self.opts = dae_fn, opts
-        self._shifted = {}  # normalized -> shifted DAE
+        self._shifted = {}  # normalized -> shifted DAE (SharedDerivatives)
+        self._plain = None  # the DAE itself (SharedDerivatives), for IDACalcIC
         self._built = {}
 
     def get(self, grid, solver: str, shifted: bool, normalized: bool = False, level: int | None = None,
@@ -102,7 +153,7 @@ class CallIntegrators:
         if integ is None:
             if shifted:
                 if normalized not in self._shifted:
-                    self._shifted[normalized] = shifted_dae(self.dae_fn, normalized)
+                    self._shifted[normalized] = SharedDerivatives(shifted_dae(self.dae_fn, normalized))
                 # IDAS's first step would be a thousandth of the first output time (xi_dot = 0
                 # gives it no other scale): the call's length instead, so that the steps do not
                 # depend on the outputs inside the call.
@@ -111,7 +162,9 @@ class CallIntegrators:
                 if max_step is not None:
                     opts["max_step_size"] = max_step
             else:
-                dae, opts = self.dae_fn, self.opts
+                if self._plain is None:
+                    self._plain = SharedDerivatives(self.dae_fn)
+                dae, opts = self._plain, self.opts
             if len(self._built) >= MAX_INTEGRATORS:
                 del self._built[next(iter(self._built))]  # the oldest
             integ = self._built[key] = ca.integrator("idas", "idas", dae, 0.0, grid, {**opts, "linear_solver": solver})

@@ -3,7 +3,8 @@ state's scaled departure from its linear extrapolation, consistent at zero for e
 import casadi as ca
 import numpy as np
 
-from symcat.integrate.shifted import WARP_ANCHORS, WARP_MAX, CallIntegrators, shifted_dae, warped_grid
+from symcat.integrate.shifted import (WARP_ANCHORS, WARP_MAX, CallIntegrators, SharedDerivatives, shifted_dae,
+                                      warped_grid)
 
 
 def _dae():
@@ -92,3 +93,27 @@ def test_a_warped_call_puts_its_output_on_a_cached_grid_and_matches_the_plain_on
         direct = ca.integrator("i", "idas", dae, 0.0, times.tolist(), {**opts, "init_xdot": x_dot.tolist()})
         np.testing.assert_allclose(x_warped, np.asarray(direct(x0=x_a, z0=z_a, p=p)["xf"]), rtol=0, atol=1e-7)
     assert len(used) == 1
+
+
+def test_integrators_share_the_derived_functions_and_integrate_as_the_dae_itself():
+    """Integrators built on :class:`SharedDerivatives` take the residual and Jacobian functions
+    derived for the first one (none derived again, however many grids) and give bit-identical
+    states to integrators on the DAE itself; the wrapper evaluates as the DAE."""
+    dae = _dae()
+    x_a, p = np.array([0.4, -1.2]), np.array([0.7, 40.0])
+    z_a = 0.5 * x_a[0] ** 2
+    x_dot = np.asarray(dae(0.0, x_a, z_a, p, ca.DM(0, 1))[0]).ravel()
+    shared = SharedDerivatives(dae)
+    opts = {"reltol": 1e-8, "abstol": 1e-10, "calc_ic": False, "init_xdot": x_dot.tolist()}
+    for n, grid in enumerate(([0.1, 0.5], [0.2, 0.3, 0.5], [0.5])):
+        own = ca.integrator("i", "idas", dae, 0.0, grid, opts)(x0=x_a, z0=z_a, p=p)
+        via = ca.integrator("i", "idas", shared, 0.0, grid, opts)(x0=x_a, z0=z_a, p=p)
+        assert np.array_equal(np.asarray(via["xf"]), np.asarray(own["xf"]))
+        assert np.array_equal(np.asarray(via["zf"]), np.asarray(own["zf"]))
+        if n == 0:
+            derived = dict(shared.derived)
+            assert {key[0] for key in derived} >= {"daeF", "jacF"}
+    assert shared.derived == derived  # the later integrators derived nothing
+    args = (0.3, x_a, z_a, p, ca.DM(0, 1))
+    for a, b in zip(shared(*args), dae(*args)):
+        assert np.array_equal(np.asarray(a), np.asarray(b))
