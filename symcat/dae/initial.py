@@ -38,6 +38,19 @@ def _build_terms_function(form: Formulation) -> ca.Function:
     return ca.Function("terms", [q, v, s, w, t, sc], outs, ["q", "v", "s", "w", "t", "sc"], names + ["T_sc"])
 
 
+def _kkt_pattern(form: Formulation, fn: ca.Function, closed) -> "KKTPattern":
+    """The :class:`KKTPattern` of the terms function ``fn`` with the ``closed`` rows, kept on
+    ``form`` (a contact driver makes the state consistent after every jump, with a few sets of
+    closed rows; assembling the matrix by ``scipy.sparse.bmat`` cost ten times the factorization)."""
+    cached = getattr(form, "_kkt_patterns", None)
+    if cached is None or cached[0] is not fn:  # a new terms function (a window moved)
+        cached = form._kkt_patterns = (fn, {})
+    patterns, key = cached[1], closed.tobytes()
+    if key not in patterns:
+        patterns[key] = KKTPattern(fn.sparsity_out("M"), fn.sparsity_out("Cq"), fn.sparsity_out("Cs"), closed)
+    return patterns[key]
+
+
 def locate_contacts(fn: ca.Function, q, v, s, w, t, sc, tol: float = 1e-12, max_iterations: int = 50) -> np.ndarray:
     """Contact arc lengths solving the tangency conditions for given coordinates (scalar Newton
     per contact; each tangency depends on its own arc length only)."""
@@ -80,10 +93,13 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     names = [model.row_names[r] for r in closed]
     n_f = form.n_f
 
+    raw = {}  # the last evaluation's M, C_q, C_s (casadi, all rows), for the KKT pattern
+
     def evaluate(q, v, s, w):
         """The closed rows' terms."""
         out = fn(q, v, s, w, t0, sc)
         c, cq, cs, ct, qd, m, f = out[:7]
+        raw.update(m=m, cq=cq, cs=cs)
         cq = to_scipy(ca.DM(cq)).tocsr()[closed].tocsc()
         cs = np.asarray(ca.densify(cs))[closed]
         return (np.asarray(c).ravel()[closed], sps.hstack([cq, sps.csc_matrix(cs)]).tocsc(),
@@ -127,7 +143,8 @@ def consistent_state(form: Formulation, t0: float = 0.0, tol: float = 1e-12, max
     z0 = np.zeros(sum(b.size for b in zb.values()))
     creep = CreepCoupling(form, q, v, s, w)
     if form.formulation == "augmented":
-        solve = kkt_solver_closed(m, cq, cs, closed, form.n_c)  # one factorization for every creep pass
+        # One factorization for every creep pass, the matrix assembled by the pattern's index maps.
+        solve = _kkt_pattern(form, fn, closed).solver(*(np.asarray(raw[k].nonzeros()) for k in ("m", "cq", "cs")))
         a, s_dd, lam = creep.solve(lambda force: solve(force, qd), f)
         values_x = {"q": q, "s": s, "v": v, "w": w}
         values_z = {"a": a, "s_dd": s_dd, "w": w, "lambda": lam, "mu": np.zeros(form.n_c), "sc": sc}
