@@ -185,6 +185,8 @@ class ContactStepper:
                 except RuntimeError as err:
                     if exc is None:  # the first attempt's reason: the fallbacks' are consequences
                         exc, self.idas_said = err, said.getvalue().strip().splitlines()[-1:]
+                        if normalized and self.idas_said:  # IDAS's t and h are fractions of the call
+                            self.idas_said[0] += f" [in the call's normalized time; the call: {h:.6g} s from t = {t_a:.6g} s]"
                     continue
             st = integ.stats()
             for k in self.stat_keys:
@@ -253,6 +255,13 @@ class ContactStepper:
         """:func:`.late_jumps.late_jump_time` of a call of ``h`` seconds from ``t``."""
         refused = {name: s1 for name, (s1, until) in self.refused.items() if t + h < until}
         return late_jump_time(self.checks, checks_end, h, refused, self.early_m)
+
+    @staticmethod
+    def _redo_units(t_late: float, dt: float, end: int) -> int:
+        """Length, in units of the finest level ``dt / end``, of the call that redoes one
+        which passed a contact jump ``t_late`` seconds after its start (as :meth:`_next_end`
+        places a call ending at an event)."""
+        return max(1, round(max(LATE_JUMP_EARLY * t_late, MIN_SPAN_S) / dt * end))
 
     def _kept_output(self, t: float, offsets, xs, zs, before: float):
         """:func:`.late_jumps.kept_output` of a call from ``t`` that passed a contact jump."""
@@ -396,6 +405,10 @@ class ContactStepper:
             checks_end = check_contacts(self.form, xs_new[:, -1], zs_new[:, -1])
             if h > shortest:
                 t_late = self._late_jump(checks_end, h, t)
+                if t_late is not None and self._redo_units(t_late, dt, end) >= pos_b - pos:
+                    # The redo, on the grid of the finest level, would be this call again (a
+                    # crossing within a unit or two of its start): keep it, the check jumps.
+                    t_late = None
                 if t_late is not None:
                     # A rival sank below the followed point unpredicted: redo up to before it.
                     self.stats["jump_redos"] += 1

@@ -110,3 +110,45 @@ def test_a_late_jump_keeps_the_call_up_to_its_last_output_before_the_crossing(mo
     assert stepper._kept_output(0.0, offsets, xs, xs, 2.5e-3) is None
     states[2.0] = _check(rivals=[_rival(0.001, -1e-9)])  # nanometres below: the next check jumps
     assert stepper._kept_output(0.0, offsets, xs, xs, 2.5e-3)[0] == 1
+
+
+def test_a_late_jump_within_two_units_of_the_finest_grid_does_not_redo_the_same_call(monkeypatch):
+    """A crossing 1.8 units of the finest grid after a call's start: the redo, rounded to that
+    grid, would be the call of 2 units again, and again (the S1002 wheelset at rtol 1e-6 over 4 s
+    with 200 outputs repeated one call 11000 times at t = 0.226 s). The call is kept and the
+    check at its end jumps; the driver goes on to the end of the span."""
+    import symcat.integrate.contact_stepping as stepping
+
+    dt = 0.1
+    k_max = math.ceil(math.log2(dt / stepping.MIN_SPAN_S))
+    unit = dt / 2**k_max
+    calls = []
+
+    def call(x, z, t, h, inner, free):
+        calls.append((t, h))
+        if len(calls) > 50:
+            raise AssertionError(f"the driver repeats its call at t = {t}")
+        return np.column_stack([x] * (len(inner) + 1)), np.column_stack([z] * (len(inner) + 1))
+
+    def late(checks_end, h, t):  # one crossing, at 1.8 units, seen by any call from 0 passing it
+        return 1.8 * unit if t == 0.0 and h > 1.8 * unit else None
+
+    stepper = _stepper(checks=[_check()])
+    stepper.form, stepper.stats = None, {"contact_calls": 0, "jump_redos": 0, "switch_redos": 0}
+    stepper.span, stepper.event = dt, math.inf
+    stepper.switching = SimpleNamespace(overshoot=lambda *a: None)
+    stepper.call, stepper._late_jump = call, late
+
+    def after(x, z, t, relaxed=False, checks=None):  # the check after a call sets the span anew
+        stepper.span, stepper.event = dt, math.inf
+        return x, z, []
+
+    stepper._after = after
+    monkeypatch.setattr(stepping, "check_contacts", lambda form, x, z: [_check()])
+    monkeypatch.setattr(stepping, "lost_contact", lambda form, x, z, checks: None)
+    x, z = stepper.advance(np.zeros(1), np.zeros(1), 0.0, [dt])
+    assert calls[0] == (0.0, dt)
+    # the redo: 0.9 * 1.8 units, on the grid 2 units, kept although it passes the crossing
+    assert calls[1] == (0.0, pytest.approx(2 * unit))
+    assert calls[2][0] == pytest.approx(2 * unit)
+    assert stepper.stats["jump_redos"] == 1

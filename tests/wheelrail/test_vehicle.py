@@ -221,6 +221,7 @@ def test_idas_messages_on_retried_calls_stay_quiet_and_a_final_failure_reports_o
     call) names IDAS's message of that call in its report."""
     from symcat.errors import SolverError
 
-    with pytest.raises(SolverError, match=r"\(IDAS: At t = .*\)"):
+    # IDAS counts time in the call's normalized time: the report says so, and gives the call
+    with pytest.raises(SolverError, match=r"\(IDAS: At t = .*\[in the call's normalized time; the call: .* s from t = .* s\]\)"):
         simulate(_vehicle_model(), 0.01, index="ggl", max_steps=3, progress=False)
     assert capsys.readouterr().err == ""
