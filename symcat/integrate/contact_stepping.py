@@ -256,13 +256,6 @@ class ContactStepper:
         refused = {name: s1 for name, (s1, until) in self.refused.items() if t + h < until}
         return late_jump_time(self.checks, checks_end, h, refused, self.early_m)
 
-    @staticmethod
-    def _redo_units(t_late: float, dt: float, end: int) -> int:
-        """Length, in units of the finest level ``dt / end``, of the call that redoes one
-        which passed a contact jump ``t_late`` seconds after its start (as :meth:`_next_end`
-        places a call ending at an event)."""
-        return max(1, round(max(LATE_JUMP_EARLY * t_late, MIN_SPAN_S) / dt * end))
-
     def _kept_output(self, t: float, offsets, xs, zs, before: float):
         """:func:`.late_jumps.kept_output` of a call from ``t`` that passed a contact jump."""
         return kept_output(lambda x, z: check_contacts(self.form, x, z), self._late_jump, t, offsets, xs, zs, before)
@@ -405,16 +398,18 @@ class ContactStepper:
             checks_end = check_contacts(self.form, xs_new[:, -1], zs_new[:, -1])
             if h > shortest:
                 t_late = self._late_jump(checks_end, h, t)
-                if t_late is not None and self._redo_units(t_late, dt, end) >= pos_b - pos:
-                    # The redo, on the grid of the finest level, would be this call again (a
-                    # crossing within a unit or two of its start): keep it, the check jumps.
-                    t_late = None
-                if t_late is not None:
+                redo = None if t_late is None else max(LATE_JUMP_EARLY * t_late, MIN_SPAN_S)
+                if redo is not None and max(1, round(redo / dt * end)) >= pos_b - pos:
+                    # The redo, rounded to the finest grid as :meth:`_next_end` rounds an event,
+                    # would be this call again (a crossing a unit or two after its start): keep
+                    # the call, and the check at its end jumps.
+                    redo = None
+                if redo is not None:
                     # A rival sank below the followed point unpredicted: redo up to before it.
                     self.stats["jump_redos"] += 1
                     # A free call to just before it (the rival, then above, is predicted),
                     # from the last output inside the call before it if there is one.
-                    self.span = self.event = max(LATE_JUMP_EARLY * t_late, MIN_SPAN_S)
+                    self.span = self.event = redo
                     kept = self._kept_output(t, inner, xs_new, zs_new, self.span)
                     if kept is None:
                         continue
