@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import logging
 import math
 import os
 import time
@@ -19,6 +20,8 @@ from typing import Any, Callable
 from .errors import ParameterError, SymcatError
 
 PACKAGE_DIR = Path(__file__).resolve().parent
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -178,12 +181,19 @@ class RunResult:
     files: list
 
 
+def shipped_models_dir() -> Path:
+    """The models that ship with symcat: ``symcat/_models`` of an installed package (see
+    ``pyproject.toml``), else ``models/`` of the source tree."""
+    installed = PACKAGE_DIR / "_models"
+    return installed if installed.is_dir() else PACKAGE_DIR.parent / "models"
+
+
 def models_dirs() -> list[Path]:
-    dirs = []
-    if os.environ.get("SYMCAT_MODELS"):
-        dirs.append(Path(os.environ["SYMCAT_MODELS"]))
-    dirs += [Path.cwd() / "models", PACKAGE_DIR.parent / "models"]
-    return dirs
+    """Where models are found by name: the folders of ``$SYMCAT_MODELS`` (separated by
+    ``os.pathsep``), then the shipped models. The working directory is not searched (a file
+    there must not silently replace a shipped model): run a model of your own by its path."""
+    user = [Path(d) for d in os.environ.get("SYMCAT_MODELS", "").split(os.pathsep) if d]
+    return user + [shipped_models_dir()]
 
 
 def available_models() -> list[str]:
@@ -194,14 +204,31 @@ def available_models() -> list[str]:
     return sorted(names)
 
 
-def load_model(name_or_path: str) -> Model:
-    """Find a model by name (``models/<name>.py``) or by file path."""
+def model_path(name_or_path: str) -> Path:
+    """The file of a model given by name or path.
+
+    A name found both in ``$SYMCAT_MODELS`` and among the shipped models resolves to the
+    user's file, with a warning naming both.
+    """
     path = Path(name_or_path)
-    if not (path.suffix == ".py" and path.is_file()):
-        path = next((d / f"{name_or_path}.py" for d in models_dirs() if (d / f"{name_or_path}.py").is_file()), None)
-        if path is None:
-            known = ", ".join(available_models()) or "none found"
-            raise ParameterError(f"model={name_or_path!r}: no such model (available: {known})")
+    if path.suffix == ".py" or os.sep in name_or_path:
+        if not path.is_file():
+            raise ParameterError(f"model={name_or_path!r}: no such file")
+        return path
+    found = [d / f"{name_or_path}.py" for d in models_dirs() if (d / f"{name_or_path}.py").is_file()]
+    if not found:
+        known = ", ".join(available_models()) or "none found"
+        raise ParameterError(f"model={name_or_path!r}: no such model (available: {known})")
+    shipped = shipped_models_dir() / f"{name_or_path}.py"
+    if found[0] != shipped and shipped.is_file():
+        log.warning("model %s: running %s, which shadows the shipped model %s (SYMCAT_MODELS)",
+                    name_or_path, found[0], shipped)
+    return found[0]
+
+
+def load_model(name_or_path: str) -> Model:
+    """Find a model by name (``models/<name>.py``, see :func:`models_dirs`) or by file path."""
+    path = model_path(name_or_path)
     spec = importlib.util.spec_from_file_location(f"symcat_model_{path.stem}", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)

@@ -11,7 +11,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("action", choices=["generate", "check", "compile"])
     parser.add_argument("libraries", nargs="*", help="library names (default: all)")
     args = parser.parse_args(argv)
-    from .generate import generate, stale_libraries
+    from .generate import generate, stale_libraries, tool_mismatches
     from .kernels import library_names
 
     names = args.libraries or library_names()
@@ -24,6 +24,11 @@ def main(argv: list[str] | None = None) -> int:
         stale = [n for n in stale_libraries() if n in names]
         if stale:
             print(f"stale generated code: {', '.join(stale)}; run `make generate` and commit generated/", file=sys.stderr)
+            return 1
+        mismatches = tool_mismatches()
+        if mismatches:
+            print(f"generated code made with {', '.join(mismatches)}: install the versions pinned in "
+                  "pyproject.toml (`make install`), or change the pins and run `make generate`", file=sys.stderr)
             return 1
         print("generated code is current")
         return 0

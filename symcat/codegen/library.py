@@ -22,7 +22,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import CompilerError
-from .paths import cache_dir, file_sha256, generated_dir, read_manifest, source_hash
+from .paths import cache_dir, generated_dir, is_current, read_manifest, read_sx_text, regenerated_dir, sx_path
 
 log = logging.getLogger(__name__)
 
@@ -195,26 +195,46 @@ class BufferedFunction:
 _LOADED: dict[str, KernelLibrary] = {}
 
 
-def ensure_generated(name: str) -> Path:
-    """Path of current generated C for ``name``, regenerating it if stale (imports SymPy)."""
-    entry = read_manifest()["libraries"].get(name)
-    path = generated_dir() / f"{name}.c"
-    if entry is not None and path.exists() and entry["source_hash"] == source_hash(name):
-        if entry["c_sha256"] == file_sha256(path):
-            return path
-    log.warning("kernel library %s is missing or stale: regenerating it (run `make generate`)", name)
+_FOLDERS: dict[str, Path] = {}
+
+
+def generated_folder(name: str) -> Path:
+    """The folder whose code of library ``name`` is current: the shipped ``generated/`` or, if
+    that is stale or missing there, :func:`~.paths.regenerated_dir` in the cache, where it is
+    regenerated on first need (imports SymPy; the source tree is never written by a run)."""
+    folder = _FOLDERS.get(name)
+    if folder is not None:
+        return folder
+    for folder in (generated_dir(), regenerated_dir()):
+        if is_current(folder, name):
+            _FOLDERS[name] = folder
+            return folder
+    folder = regenerated_dir()
+    log.warning("kernel library %s is missing or stale in %s: regenerating it into %s (once; "
+                "`make generate` updates the shipped code)", name, generated_dir(), folder)
     from .generate import generate  # deferred: imports SymPy
 
-    generate([name], verbose=False)
-    return path
+    generate([name], out_dir=folder, verbose=False)
+    _FOLDERS[name] = folder
+    return folder
+
+
+def ensure_generated(name: str) -> Path:
+    """Path of current generated C for ``name`` (see :func:`generated_folder`)."""
+    return generated_folder(name) / f"{name}.c"
 
 
 class SymbolicKernelLibrary(KernelLibrary):
-    """A kernel library as CasADi SX functions, derived from its symbolic sources (imports
-    SymPy): a graph built from them expands into one SX function (see :func:`symbolic_kernels`)."""
+    """A kernel library as CasADi SX functions, deserialized from the generated code (no
+    SymPy): a graph built from them expands into one SX function (see :func:`symbolic_kernels`).
+    The ``jac_`` companions are not shipped in this form (the expanded graph is differentiated
+    as a whole); asking for one derives the library in SymPy."""
 
     def __getitem__(self, function: str) -> ca.Function:
         if not self.functions:
+            text = read_sx_text(sx_path(generated_folder(self.name), self.name))
+            self.functions.update((f.name(), f) for f in map(ca.Function.deserialize, text.splitlines()))
+        if function not in self.functions:
             from .kernels import library_functions  # deferred: imports SymPy
 
             self.functions.update((f.name(), f) for f in library_functions(self.name))
@@ -267,6 +287,5 @@ def library_interface(name: str) -> dict:
     """
     info = _INTERFACES.get(name)
     if info is None:
-        ensure_generated(name)
-        info = _INTERFACES[name] = read_manifest()["libraries"][name]["interface"]
+        info = _INTERFACES[name] = read_manifest(generated_folder(name))["libraries"][name]["interface"]
     return info

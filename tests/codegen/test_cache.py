@@ -95,4 +95,67 @@ def test_generation_is_reproducible(tmp_path):
 
     entry = generate_library("slope_moment", tmp_path)
     assert (tmp_path / "slope_moment.c").read_bytes() == (generated_dir() / "slope_moment.c").read_bytes()
-    assert entry["c_sha256"] == json.loads((generated_dir() / "manifest.json").read_text())["libraries"]["slope_moment"]["c_sha256"]
+    shipped = json.loads((generated_dir() / "manifest.json").read_text())["libraries"]["slope_moment"]
+    assert entry["c_sha256"] == shipped["c_sha256"] and entry["sx_sha256"] == shipped["sx_sha256"]
+
+
+def test_compiled_model_dae_on_a_cold_model_cache_does_not_import_sympy(tmp_path):
+    """The whole-model DAE expands the kernels' shipped SX (generated/*.sx.gz), not SymPy."""
+    for name in ("rigid", "driving_rigid_ground", "pointload_rigid", "wheelrail_railframe_rigid_ground"):
+        lib_mod.kernel_library(name)  # warm kernels in the shared cache
+    cache = tmp_path / "cache"
+    cache.mkdir()
+    for so in lib_mod.cache_dir().glob("*.so"):
+        if not so.name.startswith("model_"):
+            (cache / so.name).symlink_to(so)  # kernels warm, model libraries cold
+    code = (
+        "import sys\n"
+        "from tests.codegen.test_model_dae import _wheelset\n"
+        "from symcat.integrate import simulate\n"
+        "from symcat.codegen.model_dae import COMPILED\n"
+        "res = simulate(_wheelset(), 0.002, 'augmented', 'ggl', rtol=1e-6, n_out=2, compiled=True)\n"
+        "print(int('sympy' in sys.modules), COMPILED['n'], len(res.t_s))\n"
+    )
+    env = {**os.environ, "SYMCAT_CACHE": str(cache), "SYMCAT_OPTIMIZE": "off"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["0", "1", "3"], out.stderr
+
+
+def test_pinned_tool_versions_are_those_the_generated_code_was_made_with():
+    """pyproject.toml pins SymPy and CasADi to the manifest's versions: an install on any later
+    day regenerates the shipped code byte for byte and reads it as current."""
+    import re
+
+    from symcat.codegen.paths import TOOLS, read_manifest
+
+    text = (ROOT / "pyproject.toml").read_text()
+    pins = {tool: re.search(rf'"{tool}==([^"]+)"', text) for tool in TOOLS}
+    assert all(pins.values()), f"pyproject.toml must pin {', '.join(TOOLS)} with =="
+    recorded = {(tool, entry[tool]) for entry in read_manifest()["libraries"].values() for tool in TOOLS}
+    assert recorded == {(tool, pin.group(1)) for tool, pin in pins.items()}
+
+
+def test_stale_shipped_code_is_regenerated_into_the_cache_not_the_source_tree(tmp_path):
+    """A run that meets stale shipped code regenerates it into the cache and leaves the
+    shipped folder (the source tree, or an installed package) as it was."""
+    shipped = tmp_path / "generated"
+    shipped.mkdir()
+    for name in ("manifest.json", "slope_moment.c", "slope_moment.sx.gz"):
+        shutil.copy(generated_dir() / name, shipped / name)
+    manifest = json.loads((shipped / "manifest.json").read_text())
+    manifest["libraries"]["slope_moment"]["source_hash"] = "0" * 64
+    (shipped / "manifest.json").write_text(json.dumps(manifest))
+    before = {p.name: p.read_bytes() for p in shipped.iterdir()}
+    env = {**os.environ, "SYMCAT_GENERATED": str(shipped), "SYMCAT_CACHE": str(tmp_path / "cache")}
+    code = "from symcat.codegen.library import kernel_library; print(kernel_library('slope_moment').path)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env)
+    assert out.returncode == 0, out.stderr
+    assert "regenerating it into" in out.stderr
+    assert {p.name: p.read_bytes() for p in shipped.iterdir()} == before
+    regenerated = tmp_path / "cache" / "generated"
+    assert (regenerated / "slope_moment.c").read_bytes() == (generated_dir() / "slope_moment.c").read_bytes()
+    # A second run finds the regenerated code current and derives nothing.
+    again = subprocess.run([sys.executable, "-c", code + "; import sys; print(int('sympy' in sys.modules))"],
+                           capture_output=True, text=True, cwd=ROOT, env=env)
+    assert again.returncode == 0 and again.stdout.split()[-1] == "0" and "regenerating" not in again.stderr
