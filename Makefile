@@ -33,6 +33,7 @@ bench: install compile
 
 demo: install
 	$(VENV)/bin/symcat run cantilever --out out/cantilever
+	@echo "make demo: the plot (cantilever.png), the ParaView file (cantilever.vtu) and summary.json are in $(CURDIR)/out/cantilever/"
 
 clean:
 	rm -rf out build *.egg-info .pytest_cache

@@ -184,18 +184,6 @@ def global_assembly(n_elements=1000):
     return rows
 
 
-# --- 4. warm start-up of `symcat run` ----------------------------------------------------------
-def startup_times():
-    exe = Path(sys.executable).with_name("symcat")
-    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "symcat.cli"]
-    rows = []
-    for model in ("cantilever", "rollup", "taut_wire", "hanging_cable"):
-        run = lambda: subprocess.run([*cmd, "run", model, "--quiet"], check=True, cwd=ROOT, capture_output=True)
-        run()
-        rows.append((model, median_time(run, 5)))
-    return rows
-
-
 def main():
     REPORT.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -205,7 +193,9 @@ def main():
     kern = kernel_times()
     glob = global_assembly()
     print("start-up ...", flush=True)
-    start = startup_times()
+    from bench.startup import section as startup_section
+
+    startup = startup_section(REPORT)
     print("code generation costs ...", flush=True)
     cg = codegen_costs()
     cold = cold_generate()
@@ -277,14 +267,7 @@ def main():
         f"**{cold:.1f} s** (target below 60 s). Compiling all libraries: {sum(r[3] for r in cg):.1f} s, "
         "once per machine (cached by content).",
         "",
-        "## Warm start-up of `symcat run` (whole process, default parameters)",
-        "",
-        "| model | wall [s] |",
-        "|---|---:|",
-        *[f"| {m} | {t:.2f} |" for m, t in start],
-        "",
-        "Target: below 2 s.",
-        "",
+        *startup,
         *dynamics,
         "",
         *pantograph,

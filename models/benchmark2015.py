@@ -16,7 +16,7 @@ from symcat.catenary import benchmark2015
 from symcat.errors import ParameterError
 from symcat.interaction.model_support import NUMERICAL_PARAMETERS, numerical_options, passage_output
 from symcat.interaction.passage import run_passage, spans_needed
-from symcat.model import Model, Parameter
+from symcat.model import Model, Parameter, comma_numbers, numbers_check
 from symcat.pantograph import LumpedPantograph, benchmark2015_pantograph
 
 PARAMETERS = [
@@ -34,23 +34,15 @@ PARAMETERS = [
     Parameter("aero_coefficient_N_s2_m2", 0.0, "N s^2/m^2", "aerodynamic uplift on the pan-head, c v^2 (v in m/s)",
               minimum=0.0),
     Parameter("pantograph_damping_N_s_m", "0,0,0", "N s/m", "dampers of the three stages from the roof up, "
-              "comma-separated (the public set gives none)"),
+              "comma-separated (the public set gives none)", text="three comma-separated numbers >= 0",
+              check=numbers_check(3, 0.0)),
     Parameter("presag_scale", 1.0, "-", "factor on the benchmark presag target (55 mm at mid-span)", minimum=0.0),
     Parameter("contact_wire_tension_N", 22000.0, "N", "contact-wire tension", minimum=0.0, exclusive_minimum=True),
     Parameter("messenger_tension_N", 16000.0, "N", "messenger-wire tension", minimum=0.0, exclusive_minimum=True),
     Parameter("dropper_positions_m", "", "m", "dropper positions from the start of a span, comma-separated; "
-              "empty: the benchmark's nine"),
+              "empty: the benchmark's nine", text="comma-separated numbers inside the span, or nothing",
+              check=numbers_check(minimum=0.0, empty=True)),
 ] + NUMERICAL_PARAMETERS
-
-
-def _floats(name: str, text: str, count: int | None = None) -> tuple[float, ...]:
-    try:
-        values = tuple(float(v) for v in text.split(",") if v.strip())
-    except ValueError:
-        raise ParameterError(f"{name}={text!r}: must be comma-separated numbers") from None
-    if count is not None and len(values) != count:
-        raise ParameterError(f"{name}={text!r}: need {count} values")
-    return values
 
 
 def design_from(p: dict):
@@ -67,7 +59,7 @@ def design_from(p: dict):
     changes["contact_wire"] = replace(d.contact_wire, tension=p["contact_wire_tension_N"])
     changes["messenger_wire"] = replace(d.messenger_wire, tension=p["messenger_tension_N"])
     if p["dropper_positions_m"].strip():
-        pos = _floats("dropper_positions_m", p["dropper_positions_m"])
+        pos = comma_numbers(p["dropper_positions_m"], "dropper_positions_m")
         for x in pos:
             if not 0 < x < d.span_length:
                 raise ParameterError(f"dropper_positions_m: {x:g} m is outside the span (0..{d.span_length:g} m)")
@@ -83,7 +75,7 @@ def run(p: dict):
         raise ParameterError(f"speed_kmh={p['speed_kmh']:g} km/h: must be below the contact-wire wave speed "
                              f"{design.wave_speed * 3.6:.1f} km/h")
     base = benchmark2015_pantograph(p["speed_kmh"])
-    damping = _floats("pantograph_damping_N_s_m", p["pantograph_damping_N_s_m"], 3)
+    damping = comma_numbers(p["pantograph_damping_N_s_m"], "pantograph_damping_N_s_m", 3)
     uplift = base.uplift if p["uplift_N"] < 0 else p["uplift_N"]
     panto = LumpedPantograph(base.masses, base.stiffness, damping, uplift, base.uplift_stage,
                              aero_coefficient=p["aero_coefficient_N_s2_m2"], name=base.name, sources=base.sources)

@@ -93,13 +93,15 @@ def run(p: dict) -> ModelOutput:
         "steps": res.stats["steps"],
     }
     def write(out):
+        from symcat.results.paraview import write_multibody_series
         from symcat.results.timeseries import plot_histories
 
         res.save(out / "pendulum.npz")
         plot = plot_histories(res.t_s, {"tip x [m]": tips[:, 0], "tip y [m]": tips[:, 1],
                                         "tip error [m]": np.abs(tips[:, :2] - ref).max(axis=1),
                                         "energy change [J]": e - e[0]}, out / "pendulum.png")
-        return [out / "pendulum.npz", plot]
+        pvd = write_multibody_series(model, res.t_s, res.q, out / "paraview", "pendulum")
+        return [out / "pendulum.npz", plot, pvd]
 
     return ModelOutput(summary, res.stats, {"t_s": res.t_s, "tip_m": tips, "result": res}, write)
 

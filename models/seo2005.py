@@ -146,6 +146,7 @@ def run(p: dict) -> ModelOutput:
     }
 
     def write(out):
+        from symcat.results.paraview import write_multibody_series
         from symcat.results.timeseries import plot_histories
 
         npz = out / "seo2005.npz"
@@ -157,7 +158,8 @@ def run(p: dict) -> ModelOutput:
                   "wheel normal forces b1_ws1 [N]": wheels[names[0]]["normal_N"]}
         plot = plot_histories(res.t_s, series, out / "seo2005.png",
                               title=f"seo2005: vehicle + pantograph + catenary, {p['speed']:g} m/s")
-        return [npz, plot]
+        pvd = write_multibody_series(model, res.t_s, res.q, out / "paraview", "seo2005")
+        return [npz, plot, pvd]
 
     return ModelOutput(summary, {**{k: res.stats[k] for k in ("nsteps", "netfails", "nncfails")},
                                  "equilibrium": eq.stats()}, {"result": res, "equilibrium": eq, "layout": layout}, write)

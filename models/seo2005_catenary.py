@@ -269,6 +269,7 @@ def run(p: dict) -> ModelOutput:
     }
 
     def write(out):
+        from symcat.results.paraview import write_multibody_series
         from symcat.results.timeseries import plot_histories
 
         npz = out / "seo2005_catenary.npz"
@@ -279,7 +280,8 @@ def run(p: dict) -> ModelOutput:
         plot = plot_histories(res.t_s, {"pan-head z [m]": z, "pan-head acceleration z [m/s^2]": acc,
                                         "contact force [N]": force}, out / "seo2005_catenary.png",
                               title=f"seo2005: {p['contact']} contact, {p['element']}, {p['speed']:g} m/s")
-        return [npz, plot]
+        pvd = write_multibody_series(model, res.t_s, res.q, out / "paraview", "seo2005_catenary")
+        return [npz, plot, pvd]
 
     return ModelOutput(summary, {**res.stats, "equilibrium": eq.stats()},
                        {"result": res, "equilibrium": eq, "panhead_z_m": z, "contact_force_N": force}, write)

@@ -78,6 +78,7 @@ def run(p: dict) -> ModelOutput:
         "steps": res.stats["steps"],
     }
     def write(out):
+        from symcat.results.paraview import write_multibody_series
         from symcat.results.timeseries import plot_histories
 
         res.save(out / "slider_on_wire.npz")
@@ -85,7 +86,8 @@ def run(p: dict) -> ModelOutput:
         plot = plot_histories(res.t_s, {"s [m]": res.s_m[:, 0], "contact force z [N]": force[:, 2],
                                         "position drift [m]": res.position_drift}, out / "slider_on_wire.png",
                               title=f"{p['formulation']}, index {p['index']}")
-        return [out / "slider_on_wire.npz", plot]
+        pvd = write_multibody_series(model, res.t_s, res.q, out / "paraview", "slider_on_wire")
+        return [out / "slider_on_wire.npz", plot, pvd]
 
     return ModelOutput(summary, res.stats, {"result": res}, write)
 

@@ -30,9 +30,21 @@ Summary
 ``wheel_names``
     Contact names, in the order of the lists below (bogie ``b1`` leads; ``ws1`` is the leading
     wheelset of a bogie).
-``normal_force_static_N``, ``vertical_force_static_sum_N``
-    Normal force of each wheel at t = 0 (N) and the sum of the vertical wheel forces (equals
-    the weight).
+``normal_force_static_N``
+    Normal force of each wheel at t = 0 (N).
+``vertical_force_static_sum_N``, ``vertical_momentum_rate_static_N``
+    At t = 0: the sum of the wheels' vertical forces (normal and creep forces along the track's
+    up axis, N) and the rate of change of the vehicle's vertical momentum, the sum of ``m a_z``
+    over its bodies (N). By Newton's second law the sum is ``weight_N +
+    vertical_momentum_rate_static_N`` (to rounding, on level track). Centred, the vehicle starts
+    at rest and the sum is the weight (to 1e-9 N). Displaced, it does not start in equilibrium:
+    the suspensions start undeflected with the centred vehicle's vertical preloads, so nothing
+    holds the wheelsets against the net lateral rail force (normal forces tilted by the unequal
+    contact angles, lateral creep) and they accelerate toward the track centre; a wheelset's
+    height on its rails changes with its lateral position, so they also fall. S1002 at the
+    default 2 mm: 0.463 m/s^2 lateral, dz/dy = 0.0357, 0.0165 m/s^2 down each, -120 N for the
+    four (the sum 452729 N against the weight 452849 N); the conical 1:20 pair's dz/dy is
+    0.00028.
 ``normal_force_min_N``, ``normal_force_max_N``
     Extremes of each wheel's normal force over the run (N).
 ``lateral_displacement_max_m``
@@ -58,10 +70,10 @@ from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError, SolverError
 from symcat.integrate import simulate
 from symcat.integrate.simulate import VELOCITY_ATOL_FACTOR
-from symcat.model import Model, ModelOutput, Parameter
+from symcat.model import Model, ModelOutput, Parameter, existing_file
 from symcat.scene import Scene
 from symcat.vehicle import (DRIVES, VehicleParameters, add_vehicle, curve_track, lateral_displacement_m,
-                            lateral_force_sum_N, steady_curving_forces_N, wheel_forces)
+                            lateral_force_sum_N, momentum_rate_N, steady_curving_forces_N, wheel_forces)
 from symcat.wheelrail import PAIR_NAMES, profile_pair
 from symcat.wheelrail.track import Tangent, TrackLayout, rail_offset_for, read_irregularities
 
@@ -103,7 +115,8 @@ PARAMETERS = [
     Parameter("n_out", 100, "-", "output intervals", minimum=10, maximum=100000),
     Parameter("irregularity_file", "", "", "CSV of measured track irregularities on tangent track: header s_m (from "
               "the vehicle centre's start, m) and any of alignment_m, level_m, cross_level_m, gauge_m (m); empty: "
-              "ideal track"),
+              "ideal track",
+              text="the path of a CSV file, or nothing", check=existing_file),
 ]
 
 #: Track beyond the outermost wheelsets on a tangent layout with irregularities (m).
@@ -180,6 +193,7 @@ def summarize(res, layout) -> dict:
         "wheel_names": names,
         "normal_force_static_N": [float(forces[n]["normal_N"][0]) for n in names],
         "vertical_force_static_sum_N": float(sum(forces[n]["Q_N"][0] for n in names)),
+        "vertical_momentum_rate_static_N": float(momentum_rate_N(res, layout)[0, 2]),
         "normal_force_min_N": [float(forces[n]["normal_N"].min()) for n in names],
         "normal_force_max_N": [float(forces[n]["normal_N"].max()) for n in names],
         "lateral_displacement_max_m": [float(np.abs(y).max()) for y in lateral_displacement_m(res, layout).values()],
@@ -215,29 +229,39 @@ def run(p: dict) -> ModelOutput:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
+        from symcat.results.paraview import write_multibody_series
+        from symcat.results.timeseries import plot_merged, repeats
+
         res.save(out / "vehicle.npz")
         forces = wheel_forces(res, layout)
-        fig, axes = plt.subplots(3, 1, figsize=(8, 9), sharex=True)
-        for w, y in lateral_displacement_m(res, layout).items():
-            axes[0].plot(res.t_s, y * 1e3, lw=1, label=w)
+        fig, axes = plt.subplots(3, 1, figsize=(10, 9), sharex=True)
+        # curves equal to within 0.2 % of a panel's range share one line and one legend entry
+        # ("b1_ws1 = b2_ws1"): on tangent track bogie 2 often repeats bogie 1 exactly
+        panels = [{w: y * 1e3 for w, y in lateral_displacement_m(res, layout).items()},
+                  {n: forces[n]["normal_N"] / 1e3 for n in layout.contact_names},
+                  {n: forces[n]["Y_over_Q"] for n in layout.contact_names}]
+        groups = [plot_merged(ax, res.t_s, curves, lw=1) for ax, curves in zip(axes, panels)]
+        hidden = sum(len(group) - 1 for panel in groups for group in panel)
+        note = ("\nbogie 2's curves lie on bogie 1's (to 0.2 % of each panel's range): one line each, b1_... = b2_..."
+                if all(repeats(panel, "b1", "b2") for panel in groups) else
+                f"\n{hidden} curves lie on others (to 0.2 % of the panel's range): one line each, labels joined by ="
+                if hidden else "")
         axes[0].set_ylabel("wheelset lateral [mm]")
         where = f", curve R {p['curve_radius_m']:g} m, cant {p['cant_m'] * 1e3:g} mm" if p["curve_radius_m"] > 0 else ""
-        axes[0].set_title(f"vehicle, {p['profile']}, {p['speed_ms']:g} m/s, creep {p['creep']}{where}", fontsize=9)
-        for n in layout.contact_names:
-            axes[1].plot(res.t_s, forces[n]["normal_N"] / 1e3, lw=1, label=n)
-            axes[2].plot(res.t_s, forces[n]["Y_over_Q"], lw=1, label=n)
+        axes[0].set_title(f"vehicle, {p['profile']}, {p['speed_ms']:g} m/s, creep {p['creep']}{where}{note}",
+                          fontsize=9)
         axes[1].set_ylabel("normal force [kN]")
         axes[2].set_ylabel("Y/Q [-]")
         axes[2].set_xlabel("time [s]")
-        axes[0].legend(fontsize=7, ncol=4)
-        axes[2].legend(fontsize=6, ncol=4)
         for ax in axes:
+            ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
             ax.grid(alpha=0.3)
         fig.tight_layout()
         path = out / "vehicle.png"
         fig.savefig(path, dpi=110)
         plt.close(fig)
-        return [path, out / "vehicle.npz"]
+        pvd = write_multibody_series(model, res.t_s, res.q, out / "paraview", "vehicle")
+        return [path, out / "vehicle.npz", pvd]
 
     return ModelOutput(summary, stats, {"result": res, "layout": layout}, write)
 

@@ -49,7 +49,7 @@ from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError, SolverError
 from symcat.integrate import simulate
 from symcat.integrate.simulate import VELOCITY_ATOL_FACTOR
-from symcat.model import Model, ModelOutput, Parameter
+from symcat.model import Model, ModelOutput, Parameter, existing_file
 from symcat.scene import CreepModel, Driving, PointLoad, RigidBody, Scene, WheelRailJoint
 from symcat.wheelrail import PAIR_NAMES, WheelsetDimensions, profile_pair, wheelset_on_track
 from symcat.wheelrail.track import Tangent, TrackLayout, rail_offset_for, read_irregularities
@@ -82,7 +82,8 @@ PARAMETERS = [
               "(positions accurate to atol over motions up to 10 rad/s)", minimum=0.0, maximum=1.0),
     Parameter("n_out", 400, "-", "output intervals", minimum=10, maximum=100000),
     Parameter("irregularity_file", "", "", "CSV of measured track irregularities: header s_m (from the start, m) and "
-              "any of alignment_m, level_m, cross_level_m, gauge_m (m); empty: ideal track"),
+              "any of alignment_m, level_m, cross_level_m, gauge_m (m); empty: ideal track",
+              text="the path of a CSV file, or nothing", check=existing_file),
 ]
 
 #: Track behind the wheelset's start on a layout with irregularities (m): its contact points
@@ -213,7 +214,10 @@ def run(p: dict) -> ModelOutput:
         path = out / "wheelset.png"
         fig.savefig(path, dpi=110)
         plt.close(fig)
-        return [path, out / "wheelset.npz"]
+        from symcat.results.paraview import write_multibody_series
+
+        pvd = write_multibody_series(model, res.t_s, res.q, out / "paraview", "wheelset")
+        return [path, out / "wheelset.npz", pvd]
 
     return ModelOutput(summary, stats, arrays, write)
 

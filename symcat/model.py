@@ -8,7 +8,6 @@ returns a :class:`RunResult` whose ``summary`` holds the model's named outputs p
 from __future__ import annotations
 
 import importlib.util
-import json
 import logging
 import math
 import os
@@ -17,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
-from .errors import ParameterError, SymcatError
+from .errors import ParameterError, RunStopped, SolverError, SymcatError
 
 PACKAGE_DIR = Path(__file__).resolve().parent
 
@@ -42,6 +41,13 @@ class Parameter:
         Allowed range; ``exclusive_minimum`` makes the lower bound strict (e.g. a length > 0).
     choices : tuple of str, optional
         Allowed values of a string parameter.
+    text : str, optional
+        What a free-text parameter (a list, a file name) must be, for the help and errors,
+        e.g. "three comma-separated numbers >= 0".
+    check : callable, optional
+        ``check(name, value)`` raises :class:`ParameterError` for a value of the right type that is
+        not allowed (e.g. a file that does not exist): run with the other checks, before any
+        work.
     """
 
     name: str
@@ -52,6 +58,8 @@ class Parameter:
     maximum: float | None = None
     exclusive_minimum: bool = False
     choices: tuple[str, ...] | None = None
+    text: str | None = None
+    check: Callable[[Any], None] | None = field(default=None, compare=False, repr=False)
 
     @property
     def kind(self) -> type:
@@ -62,6 +70,8 @@ class Parameter:
             return "one of " + ", ".join(self.choices)
         if self.kind is bool:
             return "true or false"
+        if self.kind is str:
+            return self.text or "text"
         lo = "" if self.minimum is None else (f"> {self.minimum:g}" if self.exclusive_minimum else f">= {self.minimum:g}")
         hi = "" if self.maximum is None else f"<= {self.maximum:g}"
         rng = " and ".join(x for x in (lo, hi) if x)
@@ -87,6 +97,8 @@ class Parameter:
                 value = float(text)
             except ValueError:
                 raise self._reject(text) from None
+            if not math.isfinite(value):
+                raise self._reject(text)
             if self.kind is int:
                 if value != int(value):
                     raise self._reject(text)
@@ -99,6 +111,12 @@ class Parameter:
         if self.choices is not None:
             if value not in self.choices:
                 raise self._reject(value)
+            return value
+        if self.kind is str:
+            if not isinstance(value, str):
+                raise self._reject(value)
+            if self.check is not None:
+                self.check(self.name, value)
             return value
         if self.kind in (int, float):
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
@@ -113,6 +131,39 @@ class Parameter:
         if self.kind is bool and not isinstance(value, bool):
             raise self._reject(value)
         return value
+
+
+def comma_numbers(text: str, name: str = "value", count: int | None = None, minimum: float | None = None) -> tuple:
+    """The finite numbers of a comma-separated list (``count`` of them, each ``>= minimum``).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name``, the text and what is allowed.
+    """
+    need = (f"{count} " if count else "") + "comma-separated finite numbers" + (f" >= {minimum:g}" if minimum is not None else "")
+    try:
+        values = tuple(float(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise ParameterError(f"{name}={text!r}: must be {need}") from None
+    if (not all(math.isfinite(v) for v in values) or (count is not None and len(values) != count)
+            or (minimum is not None and any(v < minimum for v in values))):
+        raise ParameterError(f"{name}={text!r}: must be {need}")
+    return values
+
+
+def numbers_check(count: int | None = None, minimum: float | None = None, empty: bool = False):
+    """A :attr:`Parameter.check` for a comma-separated list of numbers (``empty``: "" allowed)."""
+    def check(name: str, text: str) -> None:
+        if not (empty and not text.strip()):
+            comma_numbers(text, name, count, minimum)
+    return check
+
+
+def existing_file(name: str, text: str) -> None:
+    """A :attr:`Parameter.check` for the path of a file to read ("" for none)."""
+    if text and not Path(text).is_file():
+        raise ParameterError(f"{name}={text!r}: no such file (give the path of a file to read, or nothing)")
 
 
 @dataclass
@@ -154,7 +205,8 @@ class Model:
         raise ParameterError(f"{name}: not a parameter of model {self.name!r} (parameters: {known})")
 
     def resolve(self, values: dict | None) -> dict:
-        """Defaults overridden by ``values`` (validated)."""
+        """Defaults overridden by ``values`` (validated; strings are parsed as on the command
+        line)."""
         params = {p.name: p.default for p in self.parameters}
         for name, value in (values or {}).items():
             p = self.parameter(name)
@@ -204,7 +256,29 @@ def available_models() -> list[str]:
     return sorted(names)
 
 
-def model_path(name_or_path: str) -> Path:
+def describe_models() -> dict[str, str]:
+    """One line of description per model by name, read from each file's ``MODEL = Model(name,
+    description, ...)`` without running it (listing the models imports none of them)."""
+    import ast
+
+    out = {}
+    for name in available_models():
+        path = model_path(name, warn=False)
+        text = ""
+        try:
+            tree = ast.parse(path.read_text())
+            for node in tree.body:
+                if (isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "MODEL" for t in node.targets)
+                        and isinstance(node.value, ast.Call) and len(node.value.args) >= 2):
+                    text = ast.literal_eval(node.value.args[1])
+            text = text or (ast.get_docstring(tree) or "").strip().splitlines()[0]
+        except (OSError, SyntaxError, ValueError, IndexError):
+            text = "(its file could not be read)"
+        out[name] = " ".join(str(text).split())
+    return out
+
+
+def model_path(name_or_path: str, warn: bool = True) -> Path:
     """The file of a model given by name or path.
 
     A name found both in ``$SYMCAT_MODELS`` and among the shipped models resolves to the
@@ -220,7 +294,7 @@ def model_path(name_or_path: str) -> Path:
         known = ", ".join(available_models()) or "none found"
         raise ParameterError(f"model={name_or_path!r}: no such model (available: {known})")
     shipped = shipped_models_dir() / f"{name_or_path}.py"
-    if found[0] != shipped and shipped.is_file():
+    if warn and found[0] != shipped and shipped.is_file():
         log.warning("model %s: running %s, which shadows the shipped model %s (SYMCAT_MODELS)",
                     name_or_path, found[0], shipped)
     return found[0]
@@ -239,8 +313,14 @@ def load_model(name_or_path: str) -> Model:
 
 
 def run_model(model: str | Model, params: dict | None = None, out: str | Path | None = None,
-              summary_path: str | Path | None = None) -> RunResult:
+              summary_path: str | Path | None = None, labels: tuple[str, str] = ("out", "summary_path")) -> RunResult:
     """Run a model.
+
+    Parameters, then ``out`` and ``summary_path``, are checked before any work. If the run's
+    time integration fails or is interrupted (Ctrl-C, see :mod:`symcat.run_control`), what was
+    computed up to then is summarized and written like a complete run, with
+    ``summary["complete"] = False`` and ``summary["stopped"]`` (time, end time, reason), and
+    :class:`~symcat.errors.RunStopped` is raised carrying that :class:`RunResult`.
 
     Parameters
     ----------
@@ -249,34 +329,73 @@ def run_model(model: str | Model, params: dict | None = None, out: str | Path | 
     params : dict, optional
         Parameter values (strings are parsed as on the command line).
     out : path, optional
-        Folder for plots, ParaView files and ``summary.json``.
+        Folder for plots, ParaView files and ``summary.json`` (created if missing). The files
+        an earlier run wrote there are removed first; other files are kept.
     summary_path : path, optional
         Where to write the summary JSON.
+    labels : tuple of str
+        How ``out`` and ``summary_path`` are named in error messages.
+
+    Raises
+    ------
+    ParameterError
+        A parameter or path that is not allowed (nothing is written).
+    RunStopped
+        The run ended early; ``.partial`` is the result so far.
     """
+    from .run_control import EarlyStop, interrupted_outside_integration, keeping_partial_results, record_stop
+    from .run_output import SUMMARY_NAME, OutputPaths, write_json
+
     m = load_model(model) if isinstance(model, str) else model
     values = m.resolve(params)
+    paths = OutputPaths(out, summary_path, labels)
     t0 = time.perf_counter()
-    output = m.run(values)
+    output = None
+    with keeping_partial_results() as recorded_stop:
+        try:
+            output = m.run(values)
+        except ParameterError:
+            paths.discard()
+            raise
+        except KeyboardInterrupt:
+            record_stop(interrupted_outside_integration())
+        except SolverError as err:  # before the time integration (statics, form finding)
+            record_stop(EarlyStop(None, None, str(err).strip().splitlines()[0], False))
+        except SymcatError:
+            paths.discard()
+            raise
+        stop = recorded_stop()
     wall = time.perf_counter() - t0
-    summary = dict(output.summary)
+    summary = dict(output.summary) if output is not None else {}
     summary["wall_s"] = wall
-    summary["stats"] = output.stats
+    summary["stats"] = output.stats if output is not None else {}
+    summary["complete"] = stop is None
+    if stop is not None:
+        summary["stopped"] = {"t_s": stop.t_s, "t_end_s": stop.t_end_s, "reason": stop.line(),
+                              "interrupted": stop.interrupted}
     files = []
-    if out is not None:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        if output.writer is not None:
-            files += [str(f) for f in output.writer(out)]
-        _write_json(out / "summary.json", {"model": m.name, "parameters": values, **summary})
-        files.append(str(out / "summary.json"))
-    if summary_path is not None:
-        _write_json(Path(summary_path), summary)
-    return RunResult(m.name, values, summary, output.arrays, files)
-
-
-def _write_json(path: Path, data: dict) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(data, indent=1, default=_jsonable) + "\n")
+    if paths.out is not None:
+        paths.clear_previous_run()
+        if output is not None and output.writer is not None:
+            try:
+                files += [str(f) for f in output.writer(paths.out)]
+            except KeyboardInterrupt:
+                stop = stop or EarlyStop(None, None, "interrupted while writing the outputs", True)
+                summary["complete"] = False
+                summary["stopped"] = {"t_s": stop.t_s, "t_end_s": stop.t_end_s, "reason": stop.line(),
+                                      "interrupted": True}
+        listed = [os.path.relpath(f, paths.out) for f in files]
+        write_json(paths.out / SUMMARY_NAME, {"model": m.name, "parameters": values, **summary, "files": listed},
+                   _jsonable)
+        files.append(str(paths.out / SUMMARY_NAME))
+    if paths.summary is not None:
+        write_json(paths.summary, summary, _jsonable)
+    result = RunResult(m.name, values, summary, output.arrays if output is not None else {}, files)
+    if stop is not None:
+        where = paths.out or paths.summary
+        kept = f"; the results so far are in {where}" if where is not None else "; the results so far are in .partial"
+        raise RunStopped(stop.line() + kept, result, stop.interrupted)
+    return result
 
 
 def _jsonable(x):

@@ -12,20 +12,21 @@ throughout:
   supports.
 """
 
-from symcat.analytic.catenary import (
-    ElasticCatenary,
-    elastic_catenary,
-    elastic_catenary_sag,
-    elastic_catenary_shape,
-    elastic_catenary_span,
-)
-from symcat.analytic.elastica import (
-    cantilever_tip_load,
-    cantilever_tip_load_linear,
-    cantilever_tip_load_ode,
-    rollup_tip_position,
-)
-from symcat.analytic.taut_wire import taut_wire_frequencies
+#: Public names by the submodule defining them, imported on first access (PEP 562): the
+#: references need SciPy's optimizer and integrators (``elastica``, ``extensible``, ``catenary``)
+#: and a model loads only the one it compares with.
+_LAZY = {
+    "ElasticCatenary": "catenary",
+    "elastic_catenary": "catenary",
+    "elastic_catenary_sag": "catenary",
+    "elastic_catenary_shape": "catenary",
+    "elastic_catenary_span": "catenary",
+    "cantilever_tip_load": "elastica",
+    "cantilever_tip_load_linear": "elastica",
+    "cantilever_tip_load_ode": "elastica",
+    "rollup_tip_position": "elastica",
+    "taut_wire_frequencies": "taut_wire",
+}
 
 __all__ = [
     "ElasticCatenary",
@@ -39,3 +40,17 @@ __all__ = [
     "rollup_tip_position",
     "taut_wire_frequencies",
 ]
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        from importlib import import_module
+
+        value = getattr(import_module(f"{__name__}.{_LAZY[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

@@ -7,12 +7,12 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sps
 
-from ..codegen.library import in_symbolic_kernels, kernel_library
+from ..codegen.library import BufferedFunction, in_symbolic_kernels, kernel_library
 from ..scene.loads import NodalForce, SlopeMoment
 from ..scene.scene import Scene
 from .dofs import DofMap
 from .element_set import ElementSet
-from .sparse import to_scipy, vector_scatter
+from .sparse import vector_scatter
 
 
 class System:
@@ -136,8 +136,25 @@ class System:
         return ca.Function("static", [q, lam], [residual, jac], ["q", "load_factor"], ["residual", "jacobian"])
 
     def eval_static(self, q: np.ndarray, load_factor: float) -> tuple[np.ndarray, sps.csc_matrix]:
-        r, j = self.static_functions(ca.DM(q), load_factor)
-        return np.asarray(r).ravel(), to_scipy(j)
+        r_nz, j_nz = self._static_buffered.nonzeros(q, load_factor)
+        r = np.zeros(self.n)
+        r[self._static_patterns[0]] = r_nz
+        j_colind, j_rows = self._static_patterns[1:]
+        return r, sps.csc_matrix((j_nz, j_rows.copy(), j_colind.copy()), shape=(self.n, self.n))
+
+    @cached_property
+    def _static_buffered(self) -> BufferedFunction:
+        """:attr:`static_functions` evaluated into NumPy arrays: the Jacobian's nonzeros and
+        pattern do not pass through Python lists (two thirds of the time of a plain call on a
+        200-coordinate beam)."""
+        return BufferedFunction(self.static_functions)
+
+    @cached_property
+    def _static_patterns(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Rows of the residual's nonzeros, and the Jacobian's column pointers and rows."""
+        fn = self.static_functions
+        j_colind, j_rows = fn.sparsity_out(1).get_ccs()
+        return np.array(fn.sparsity_out(0).get_ccs()[1], dtype=int), np.array(j_colind), np.array(j_rows)
 
     @cached_property
     def _energy_function(self) -> ca.Function:

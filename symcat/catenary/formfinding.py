@@ -23,6 +23,7 @@ import scipy.sparse.linalg as spla
 from ..analysis.statics import solve_static
 from ..assembly.system import System
 from ..errors import ParameterError, SolverError
+from ..progress import Status
 from ..scene import NodalForce, Scene
 from .design import CatenaryDesign
 from .structure import CatenaryStructure
@@ -91,8 +92,9 @@ def _balance_axial_forces(body, nodes: np.ndarray, reactions_x: np.ndarray, wire
 
 
 def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "cable3d", tol: float = 1e-8,
-              max_iterations: int = 30) -> FormFindingResult:
-    """Dropper lengths and static equilibrium for ``design`` (see the module docstring).
+              max_iterations: int = 30, progress: bool = True) -> FormFindingResult:
+    """Dropper lengths and static equilibrium for ``design`` (see the module docstring);
+    ``progress`` shows the iterations on stderr when they take more than two seconds.
 
     The tension sections of a line are independent until a pantograph couples them, so each
     is form-found on its own; the final check solves them together.
@@ -104,26 +106,31 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
         contact wire (the design cannot be reached).
     """
     t0 = time.perf_counter()
-    st = CatenaryStructure(design, elements_per_span, element)
-    n_inner = design.n_spans - 1
-    lengths, iterations = [], 0
-    for k, sec in enumerate(st.sections):
-        out = _form_section(st, k, tol, max_iterations)
-        lengths.append(out[0])
-        rows = slice(k * n_inner, (k + 1) * n_inner)
-        st.cw_supports.preload[rows], st.mw_supports.preload[rows], st.mw_supports.height[rows] = out[1:4]
-        iterations = max(iterations, out[4])
-    length0 = np.concatenate(lengths)
-    st._build_system()
-    st.set_dropper_lengths(length0)
-    q = coupled_equilibrium(st, st.q0)
+    status = Status("form finding", enabled=progress)
+    try:
+        st = CatenaryStructure(design, elements_per_span, element)
+        n_inner = design.n_spans - 1
+        lengths, iterations = [], 0
+        for k, sec in enumerate(st.sections):
+            out = _form_section(st, k, tol, max_iterations, status)
+            lengths.append(out[0])
+            rows = slice(k * n_inner, (k + 1) * n_inner)
+            st.cw_supports.preload[rows], st.mw_supports.preload[rows], st.mw_supports.height[rows] = out[1:4]
+            iterations = max(iterations, out[4])
+        length0 = np.concatenate(lengths)
+        st._build_system()
+        st.set_dropper_lengths(length0)
+        status.show("the static equilibrium of the whole line")
+        q = coupled_equilibrium(st, st.q0)
+    finally:
+        status.close()
     nodes = np.concatenate([st.dropper_nodes, st.cw_supports.nodes])
     height_error = float(np.max(np.abs(st.contact_wire_z(q)[nodes] - st.target_z[nodes])))
     _, _, tension = st.dropper_state(q)
     return FormFindingResult(st, q, length0, tension, height_error, iterations, time.perf_counter() - t0)
 
 
-def _form_section(st: CatenaryStructure, k: int, tol: float, max_iterations: int):
+def _form_section(st: CatenaryStructure, k: int, tol: float, max_iterations: int, status: Status | None = None):
     """Form finding of tension section ``k`` (steps 1-3); returns the unstretched dropper
     lengths, the steady-arm and messenger-support preloads, the messenger support heights and
     the number of iterations."""
@@ -141,6 +148,10 @@ def _form_section(st: CatenaryStructure, k: int, tol: float, max_iterations: int
     support_height = sec.messenger_support_height()
     last_change = np.inf
     for iteration in range(1, max_iterations + 1):
+        if status is not None:
+            sections = f"tension section {k + 1} of {len(st.sections)}, " if len(st.sections) > 1 else ""
+            change = f": dropper lengths changed by {last_change:.2g} m (to converge: {tol:g} m)" if iteration > 1 else ""
+            status.show(f"{sections}iteration {iteration}{change}")
         half = 0.5 * d.dropper_mass_per_length * length0 * d.gravity
         # 1. contact wire held at the design height at droppers and supports
         fixed = [(0, ["x", "y", "z"] + beam_extra), (n_nodes - 1, ["x", "y", "z"])]

@@ -81,6 +81,9 @@ def compile_c(c_path: Path, name: str, flags: tuple = CFLAGS, key_source: bytes 
     target = cached_library(name, c_path.read_bytes() if key_source is None else key_source, flags)
     if target.exists():
         return target
+    from ..progress import notice
+
+    notice(f"compiling the kernel library {name} with the C compiler (once per machine; cached in {target.parent})")
     build_library(find_compiler(), flags, c_path, target)
     return target
 
@@ -170,6 +173,26 @@ class BufferedFunction:
             flat = np.array(sp.row(), int) * sp.shape[1] + np.array(sp.get_col(), int)
             self._patterns.append((sp.shape, sp.shape[0] * sp.shape[1], flat))
 
+    def nonzeros(self, *args) -> list[np.ndarray]:
+        """The outputs' nonzeros in CasADi's (column-major) order, as new arrays: for a sparse
+        output to be built from its pattern (``function.sparsity_out(i).get_ccs()``).
+
+        Raises
+        ------
+        RuntimeError
+            If the function reports a failed evaluation (as a regular call does).
+        """
+        self._evaluate(args)
+        return [nz.copy() for nz in self._outputs]
+
+    def _evaluate(self, args) -> None:
+        for a, v in zip(self._inputs, args):
+            a[:] = v
+        self._eval()
+        if self._buffer.ret():
+            self.function(*args)  # raises CasADi's own error
+            raise RuntimeError(f"{self.function.name()}: evaluation failed")
+
     def __call__(self, *args) -> list[np.ndarray]:
         """Dense outputs (new arrays, shaped as the Function's) at the inputs ``args``.
 
@@ -178,12 +201,7 @@ class BufferedFunction:
         RuntimeError
             If the function reports a failed evaluation (as a regular call does).
         """
-        for a, v in zip(self._inputs, args):
-            a[:] = v
-        self._eval()
-        if self._buffer.ret():
-            self.function(*args)  # raises CasADi's own error
-            raise RuntimeError(f"{self.function.name()}: evaluation failed")
+        self._evaluate(args)
         out = []
         for nz, (shape, size, flat) in zip(self._outputs, self._patterns):
             dense = np.zeros(size)

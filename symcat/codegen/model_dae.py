@@ -21,6 +21,7 @@ import casadi as ca
 
 from .library import build_library, cached_library, find_compiler, merged, symbolic_kernels
 from .optimized import OPTIMIZED_FLAGS, optimize_mode, source_path, start_background
+from ..progress import notice
 from .paths import atomic_write
 
 log = logging.getLogger(__name__)
@@ -74,6 +75,7 @@ def model_library(build: Callable[[], ca.Function], fn: ca.Function, mode: str |
     if not target.exists():
         t0 = time.perf_counter()
         with tempfile.TemporaryDirectory() as tmp:
+            notice(f"compiling this model's equations with the C compiler (once per machine and model; cached in {target.parent})")
             c_path = write_dae_c(build, name, Path(tmp))
             if mode == "now":
                 log.info("compiling the model's DAE optimized (about 30 s for the seed vehicle)")

@@ -9,6 +9,8 @@ reason, the largest residual by name and the result up to the last completed chu
 """
 from __future__ import annotations
 
+import contextlib
+import io
 import logging
 import time
 
@@ -21,6 +23,7 @@ from ..dae.formulation import Formulation
 from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
+from ..run_control import check_interrupt, ended_early, integrating
 from .contact_switching import initial_open
 from .contact_stepping import CallFailed, ContactStepper
 from .failure import failure, split_state
@@ -136,7 +139,17 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
         x_dot = np.asarray(dae_fn(0.0, x, z, t_a, ca.DM(0, 1))[0]).ravel()
         grid = (np.atleast_1d(times) - t_a).tolist()
         integ = ca.integrator("idas", "idas", dae_fn, 0.0, grid, {**opts, "init_xdot": x_dot.tolist()})
-        out = integ(x0=x, z0=z, p=t_a)
+        # IDAS prints its errors (through CasADi, to sys.stderr): kept for the failure report,
+        # which is the one line the user reads.
+        with contextlib.redirect_stderr(io.StringIO()) as said:
+            try:
+                out = integ(x0=x, z0=z, p=t_a)
+            except RuntimeError as err:
+                idas = said.getvalue().strip().splitlines()[-1:]
+                if not idas:
+                    raise
+                raise RuntimeError(f"{str(err).strip().splitlines()[-1]} (IDAS: {idas[0]} [t from the call's "
+                                   f"start at {t_a:.6g} s])") from None
         st = integ.stats()
         for k in STAT_KEYS:
             stats[k] += int(st.get(k, 0))
@@ -151,72 +164,77 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
         return form.dae_function()
 
     try:
-        if model.wheelrail:
-            # Short calls with contact checks between them (see contact_stepping).
-            dae_fn = dae_function()
-            stepper = ContactStepper(form, dae_fn, opts, x, z, stats, STAT_KEYS, open_flags)
-            events = stepper.switching.events
-            # Output intervals grouped into spans of about CONTACT_GROUP_S (one per interval
-            # where element windows can move, moved between intervals): the stepper's calls cross output
-            # times, so dense output costs neither contact checks nor IDAS restarts.
-            group = 1 if model.windows_move() else max(1, int(CONTACT_GROUP_S / (t_grid[1] - t_grid[0]) + 1e-9))
-
-            def emit(j, x_j, z_j):
-                nonlocal done
-                xs.append(x_j)
-                walls.append(time.perf_counter() - wall0)
-                zs.append(z_j)
-                opens.append(stepper.switching.open.copy())
-                done = a + j + 1
-                bar.update(t_grid[done])
-
-            a = 0
-            while a < n_out:
-                if _update_windows(model, form, x, z):
-                    stats["restarts"] += 1
-                    stepper.set_dae(dae_function())
-                b = min(n_out, a + group)
-                try:
-                    x, z = stepper.advance(x, z, t_grid[a], t_grid[a + 1 : b + 1], emit)
-                except CallFailed as exc:
-                    raise failure(form, exc.error, exc.t, exc.x, exc.z, stepper.dae_fn, t_grid[1] - t_grid[0],
-                                  stepper.switching.open) from None
-                a = b
-        a, limit = (n_out if model.wheelrail else 0), None
-        while a < n_out:
-            b = _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges)
-            if limit is not None:
-                b = min(b, a + limit)
-            if _update_windows(model, form, x, z) or dae_fn is None:
-                stats["restarts"] += dae_fn is not None
+        with integrating():
+            if model.wheelrail:
+                # Short calls with contact checks between them (see contact_stepping).
                 dae_fn = dae_function()
-            try:
-                xf, zf = call(x, z, t_grid[a], t_grid[a + 1 : b + 1])
-            except RuntimeError as exc:
-                if b - a > 1 and model.windowed():
-                    # Possibly a sliding point left its window: retry shorter before giving up.
+                stepper = ContactStepper(form, dae_fn, opts, x, z, stats, STAT_KEYS, open_flags)
+                events = stepper.switching.events
+                # Output intervals grouped into spans of about CONTACT_GROUP_S (one per interval
+                # where element windows can move, moved between intervals): the stepper's calls cross output
+                # times, so dense output costs neither contact checks nor IDAS restarts.
+                group = 1 if model.windows_move() else max(1, int(CONTACT_GROUP_S / (t_grid[1] - t_grid[0]) + 1e-9))
+
+                def emit(j, x_j, z_j):
+                    nonlocal done
+                    xs.append(x_j)
+                    walls.append(time.perf_counter() - wall0)
+                    zs.append(z_j)
+                    opens.append(stepper.switching.open.copy())
+                    done = a + j + 1
+                    bar.update(t_grid[done])
+
+                a = 0
+                while a < n_out:
+                    if _update_windows(model, form, x, z):
+                        stats["restarts"] += 1
+                        stepper.set_dae(dae_function())
+                    b = min(n_out, a + group)
+                    try:
+                        x, z = stepper.advance(x, z, t_grid[a], t_grid[a + 1 : b + 1], emit)
+                    except CallFailed as exc:
+                        raise failure(form, exc.error, exc.t, exc.x, exc.z, stepper.dae_fn, t_grid[1] - t_grid[0],
+                                      stepper.switching.open) from None
+                    a = b
+                    check_interrupt(t_grid[a], t_end)
+            a, limit = (n_out if model.wheelrail else 0), None
+            while a < n_out:
+                b = _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges)
+                if limit is not None:
+                    b = min(b, a + limit)
+                if _update_windows(model, form, x, z) or dae_fn is None:
+                    stats["restarts"] += dae_fn is not None
+                    dae_fn = dae_function()
+                try:
+                    xf, zf = call(x, z, t_grid[a], t_grid[a + 1 : b + 1])
+                except RuntimeError as exc:
+                    if b - a > 1 and model.windowed():
+                        # Possibly a sliding point left its window: retry shorter before giving up.
+                        stats["retries"] = stats.get("retries", 0) + 1
+                        limit = max(1, (b - a) // 2)
+                        continue
+                    raise failure(form, exc, t_grid[a], x, z, dae_fn, t_grid[a + 1] - t_grid[a]) from None
+                if b - a > 1 and any(_left_window(model, form, xf[:, j], zf[:, j]) for j in range(b - a)):
+                    # A sliding point ran out of its window inside the call (the physics there would
+                    # be an extrapolated element): redo the call, shorter, from the same state.
                     stats["retries"] = stats.get("retries", 0) + 1
                     limit = max(1, (b - a) // 2)
                     continue
-                raise failure(form, exc, t_grid[a], x, z, dae_fn, t_grid[a + 1] - t_grid[a]) from None
-            if b - a > 1 and any(_left_window(model, form, xf[:, j], zf[:, j]) for j in range(b - a)):
-                # A sliding point ran out of its window inside the call (the physics there would
-                # be an extrapolated element): redo the call, shorter, from the same state.
-                stats["retries"] = stats.get("retries", 0) + 1
-                limit = max(1, (b - a) // 2)
-                continue
-            limit = None
-            for j in range(b - a):
-                xs.append(xf[:, j])
-                walls.append(time.perf_counter() - wall0)
-                zs.append(zf[:, j])
-            x, z = xf[:, -1], zf[:, -1]
-            done = b
-            bar.update(t_grid[b])
-            a = b
+                limit = None
+                for j in range(b - a):
+                    xs.append(xf[:, j])
+                    walls.append(time.perf_counter() - wall0)
+                    zs.append(zf[:, j])
+                x, z = xf[:, -1], zf[:, -1]
+                done = b
+                bar.update(t_grid[b])
+                a = b
+                check_interrupt(t_grid[b], t_end)
     except SolverError as err:
         bar.close()
         err.partial = collect_result(form, t_grid[: done + 1], xs, zs, stats, wall0, opens, events, walls)
+        if ended_early(err, t_grid[done], t_end):
+            return err.partial
         raise
     bar.close()
     return collect_result(form, t_grid, xs, zs, stats, wall0, opens, events, walls)

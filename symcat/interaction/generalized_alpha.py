@@ -21,6 +21,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
+from ..run_control import check_interrupt, ended_early, integrating
 from .banded import BandedCholesky
 from .coupled import CoupledLine
 from .recorder import PassageRecorder
@@ -142,31 +143,34 @@ def _integrate(line, t_end, dt, rho_inf, tol, max_iterations, record_every, prog
     acc_prev = None
     lam = fc.copy()
     try:
-        for step in range(n_steps):
-            h_target = dt
-            result = _step(line, stepper, coef, t, y, v, acc, a, lam, tol, max_iterations, acc_prev)
-            if result is None:  # refactorise at the current tangent and retry, then halve
-                refactorisations += 1
-                k_now = _current_stiffness(line, y)
-                result = _step(line, _Stepper(line, h_target, coef, k_now), coef, t, y, v, acc, a, lam, tol,
-                               max_iterations)
-                sub = 1
-                while result is None and sub < 16:
-                    sub *= 2
-                    halvings += 1
-                    result = _substeps(line, coef, t, y, v, acc, a, lam, tol, max_iterations, h_target, sub)
-                if result is None:
-                    raise SolverError(f"generalized-alpha: Newton did not converge at t={t:.6g} s even with the step "
-                                      f"divided by {sub}; look at the contact force and dropper states recorded "
-                                      "up to this time (.partial)", rec)
-            acc_prev = acc
-            y, v, acc, a, lam, states, iters = result
-            t = (step + 1) * dt
-            rec.record(t, y, v, acc, states, lam, iters)
-            bar.update(t)
+        with integrating():
+            for step in range(n_steps):
+                h_target = dt
+                result = _step(line, stepper, coef, t, y, v, acc, a, lam, tol, max_iterations, acc_prev)
+                if result is None:  # refactorise at the current tangent and retry, then halve
+                    refactorisations += 1
+                    k_now = _current_stiffness(line, y)
+                    result = _step(line, _Stepper(line, h_target, coef, k_now), coef, t, y, v, acc, a, lam, tol,
+                                   max_iterations)
+                    sub = 1
+                    while result is None and sub < 16:
+                        sub *= 2
+                        halvings += 1
+                        result = _substeps(line, coef, t, y, v, acc, a, lam, tol, max_iterations, h_target, sub)
+                    if result is None:
+                        raise SolverError(f"generalized-alpha: Newton did not converge at t={t:.6g} s even with the step "
+                                          f"divided by {sub}; look at the contact force and dropper states recorded "
+                                          "up to this time (.partial)", rec)
+                acc_prev = acc
+                y, v, acc, a, lam, states, iters = result
+                t = (step + 1) * dt
+                rec.record(t, y, v, acc, states, lam, iters)
+                bar.update(t)
+                check_interrupt(t, t_end)
     except SolverError as err:
         err.partial = rec
-        raise
+        if not ended_early(err, t, t_end):
+            raise
     finally:
         bar.close()
     rec.finish(wall_s=time.perf_counter() - wall0, dt=dt, rho_inf=rho_inf, refactorisations=refactorisations,

@@ -112,7 +112,7 @@ def run_passage(design: CatenaryDesign, pantographs: list[LumpedPantograph], spe
     if wires not in ("nonlinear", "linear"):
         raise ParameterError(f"wires={wires!r}: must be nonlinear or linear")
     if form is None:
-        form = find_form(design, elements_per_span, element)
+        form = find_form(design, elements_per_span, element, progress=progress)
     form.structure.linearize_wires(form.q if wires == "linear" else None)
     line = CoupledLine(form, runs, speed, contact, contact_stiffness, contact_damping)
     # run on past the section for the 20 Hz filter to settle: its zero-phase edge treatment

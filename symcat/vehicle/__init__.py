@@ -3,8 +3,8 @@ two wheelsets), suspensions and wheel/rail contacts, on tangent track or on a tr
 from .builder import BOGIES, DRIVES, SIDES, WHEELSETS, VehicleLayout, add_vehicle, check_start_on_tangent
 from .curving import curve_track, steady_curving_forces_N
 from .parameters import VehicleParameters
-from .wheel_forces import lateral_displacement_m, lateral_force_sum_N, wheel_forces
+from .wheel_forces import lateral_displacement_m, lateral_force_sum_N, momentum_rate_N, wheel_forces
 
 __all__ = ["BOGIES", "DRIVES", "SIDES", "WHEELSETS", "VehicleLayout", "VehicleParameters", "add_vehicle",
            "check_start_on_tangent", "curve_track", "lateral_displacement_m", "lateral_force_sum_N",
-           "steady_curving_forces_N", "wheel_forces"]
+           "momentum_rate_N", "steady_curving_forces_N", "wheel_forces"]

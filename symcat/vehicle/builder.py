@@ -84,6 +84,17 @@ class VehicleLayout:
     def contact_names(self) -> list[str]:
         return [self.contacts[w][s] for w in self.wheelsets for s in SIDES]
 
+    @property
+    def body_masses_kg(self) -> dict:
+        """``{body name: mass (kg)}`` of the vehicle's rigid bodies (they sum to
+        ``parameters.total_mass_kg``)."""
+        p = self.parameters
+        out = {self.car_body: p.car_body_mass_kg}
+        for names, mass in ((self.frames, p.frame_mass_kg), (self.bolsters, p.bolster_mass_kg),
+                            (self.equalizers, p.equalizer_mass_kg), (self.wheelsets, p.wheelset_mass_kg)):
+            out.update(dict.fromkeys(names, mass))
+        return out
+
 
 @dataclass(frozen=True)
 class _Site:

@@ -97,6 +97,24 @@ def lateral_force_sum_N(forces: dict) -> np.ndarray:
     return np.sum([f["lateral_N"] for f in forces.values()], axis=0)
 
 
+def momentum_rate_N(result, layout) -> np.ndarray:
+    """Rate of change of the vehicle's linear momentum, the sum of ``m a`` over its bodies (N,
+    global components, (n, 3) over the outputs; the accelerations ``result.a`` of the same KKT
+    solve as the contact forces).
+
+    By Newton's second law it equals the sum of the external forces on the vehicle: gravity, the
+    rail forces of :func:`wheel_forces`, the driving constraint's force (along the track) and
+    whatever else in the scene acts on the vehicle (e.g. a pantograph on the car body). On
+    level tangent track the sum of the wheels' ``Q_N`` is therefore the weight plus its ``z``
+    component, and the sum of their ``lateral_N`` its ``y`` component.
+    """
+    total = np.zeros((len(result.t_s), 3))
+    for body, mass in layout.body_masses_kg.items():
+        i = result.coordinate_names.index(f"{body}.x")
+        total += mass * np.asarray(result.a[:, i : i + 3], float)
+    return total
+
+
 def lateral_displacement_m(result, layout) -> dict:
     """Lateral displacement of each wheelset's axle centre from the track centre line toward
     the left rail, in the track frame at its chainage (m; ``{wheelset: (n,)}``). On tangent

@@ -1,4 +1,4 @@
-"""benchmark2015 and en50318 models: summaries, EN 50318 validation at 250 km/h, bad input."""
+"""benchmark2015 and en50318 models: summaries, EN 50318 validation (the whole table at 250 and 300 km/h), bad input."""
 import json
 import math
 
@@ -21,16 +21,40 @@ def test_benchmark_static_summary_has_dropper_lengths(tmp_path):
     assert json.loads((tmp_path / "summary.json").read_text())["model"] == "benchmark2015"
 
 
-def test_en50318_at_250_kmh_lands_in_the_contact_force_ranges(tmp_path):
-    """The standard's acceptance check (force statistics; see the issue notes for the uplift)."""
-    res = run_model("en50318", {"speed_kmh": 250.0, "progress": False, "paraview": True}, out=tmp_path)
-    s = res.summary
+#: The rows of the EN 50318 table outside the standard's ranges, as models/en50318.py's presag
+#: study documents them, with their values at the model's default numerical settings (60
+#: elements per span, 1 ms): ``(presag_mm, speed_kmh) -> {quantity: value}``. Every other row
+#: of the table is in range. 55 mm is the model's default presag.
+EN50318_OUTSIDE = {
+    (20.0, 250): {},
+    (20.0, 300): {},
+    (55.0, 250): {"support_uplift_max_m": 0.04422},
+    (55.0, 300): {"contact_force_mean_N": 120.41, "contact_force_std_N": 44.12, "contact_force_stat_max_N": 252.8,
+                  "contact_force_stat_min_N": -11.94, "contact_force_max_N": 239.3, "support_uplift_max_m": 0.04947},
+}
+
+
+def assert_en50318_table(summary: dict, speed: int, presag_mm: float) -> None:
+    """Every row of the EN 50318 table at ``speed`` (all of ``STAT_KEYS``): in the standard's
+    range, or outside it as :data:`EN50318_OUTSIDE` documents (value to 0.5 %)."""
+    assert set(EN50318_RANGES) == set(STAT_KEYS)  # the table covers every statistic
     for key in STAT_KEYS:
-        assert key in s and s[key] is not None and math.isfinite(s[key])
-    rows = {r[0]: r for r in check(s, 250)}
-    for key in ("contact_force_mean_N", "contact_force_std_N", "contact_force_stat_max_N",
-                "contact_force_stat_min_N", "contact_force_max_N", "contact_force_min_N", "contact_loss_percent"):
-        assert rows[key][4], f"{key}={rows[key][1]:.4g} outside {rows[key][2]}..{rows[key][3]}"
+        assert key in summary and summary[key] is not None and math.isfinite(summary[key]), key
+    rows = check(summary, speed)
+    outside = {key: value for key, value, _, _, ok in rows if not ok}
+    expected = EN50318_OUTSIDE[(presag_mm, speed)]
+    shown = {key: f"{value:.4g} (range {low:g}..{high:g})" for key, value, low, high, ok in rows if not ok}
+    assert set(outside) == set(expected), f"outside the ranges at {speed} km/h, presag {presag_mm:g} mm: {shown}"
+    for key, value in expected.items():
+        assert outside[key] == pytest.approx(value, rel=5e-3), key
+
+
+def test_en50318_at_250_kmh_lands_in_the_contact_force_ranges(tmp_path):
+    """The standard's acceptance check at the model's defaults (presag 55 mm): every force
+    statistic in range, the support uplift (44.2 mm) below its range (the presag study in
+    models/en50318.py); and the files the model writes."""
+    res = run_model("en50318", {"speed_kmh": 250.0, "progress": False, "paraview": True}, out=tmp_path)
+    assert_en50318_table(res.summary, 250, 55.0)
     for name in ("en50318_contact_force.png", "en50318_panhead.png", "en50318_uplift_droppers.png", "en50318.npz",
                  "paraview/en50318.pvd"):
         assert (tmp_path / name).is_file(), name
@@ -86,10 +110,17 @@ def test_benchmark_over_an_overlap_reports_both_wires(tmp_path):
     assert (tmp_path / "benchmark2015_contact_force.png").is_file()
 
 
+def test_en50318_at_300_kmh_with_the_default_presag_leaves_the_documented_rows_out_of_range():
+    """At the defaults (presag 55 mm) and 300 km/h the whole table as the presag study in
+    models/en50318.py documents it: sigma 44.1 N and five more out of range, the actual
+    minimum and the contact loss in."""
+    res = run_model("en50318", {"speed_kmh": 300.0, "progress": False, "paraview": False})
+    assert_en50318_table(res.summary, 300, 55.0)
+
+
 @pytest.mark.parametrize("speed", [250, 300])
 def test_en50318_with_20_mm_presag_lands_every_quantity_in_range(speed):
     """The public data leave the presag open below 55 mm; with 20 mm (the sensitivity study in
     models/en50318.py) all eight quantities, support uplift included, fall in the ranges."""
     res = run_model("en50318", {"speed_kmh": float(speed), "presag_mm": 20.0, "progress": False, "paraview": False})
-    failed = [(r[0], round(r[1], 4)) for r in check(res.summary, speed) if not r[4]]
-    assert not failed
+    assert_en50318_table(res.summary, speed, 20.0)

@@ -74,7 +74,7 @@ def test_wheelset_follows_a_long_alignment_bump_kinematically(tmp_path):
 
 
 @pytest.mark.parametrize("content, match", [
-    (None, r"irregularity_file='.*missing.csv': .*cannot be read"),
+    (None, r"irregularity_file='.*missing.csv': no such file"),
     ("alignment_m\n0\n0\n0\n0\n", r"irregularity_file=.*columns alignment_m; need s_m"),
     ("s_m,lateral_m\n0,0\n1,0\n2,0\n3,0\n", r"irregularity_file=.*unknown: lateral_m"),
     ("s_m,alignment_m\n0,0\n1,x\n2,0\n3,0\n", r"irregularity_file=.*data row 3 .* not a number"),
@@ -111,7 +111,7 @@ def test_vehicle_model_names_a_bad_irregularity_file(tmp_path):
     bad.write_text("s_m,alignment_m\n0,0\n1,0\n")
     with pytest.raises(ParameterError, match=r"irregularity_file=.*at least 4"):
         run_model("vehicle", {"irregularity_file": str(bad), "t_end": 0.01})
-    with pytest.raises(ParameterError, match=r"irregularity_file=.*cannot be read"):
+    with pytest.raises(ParameterError, match=r"irregularity_file=.*no such file"):
         run_model("vehicle", {"irregularity_file": str(tmp_path / "none.csv"), "t_end": 0.01})
     with pytest.raises(ParameterError, match=r"irregularities need tangent track"):
         run_model("vehicle", {"irregularity_file": str(bad), "curve_radius_m": 800.0, "t_end": 0.01})

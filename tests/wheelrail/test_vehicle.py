@@ -41,6 +41,41 @@ def test_static_wheel_loads_sum_to_the_weight_and_follow_the_load_path():
     assert res.position_drift.max() < 1e-7
 
 
+def test_off_centre_wheel_loads_sum_to_the_weight_plus_the_vertical_momentum_rate():
+    """Displaced by the model's default 2 mm on S1002, the vehicle does not start in
+    equilibrium: nothing holds the wheelsets against the net lateral rail force, they accelerate
+    toward the centre and, their height on the rails depending on their lateral position (dz/dy
+    0.0357 at 2 mm), fall with it. The vertical wheel forces sum to the weight plus the rate of
+    change of the vertical momentum (-120 N, the "missing" 120 N of the summary), to rounding."""
+    from symcat.vehicle import momentum_rate_N
+    from symcat.wheelrail import WheelsetDimensions, wheelset_on_track
+
+    layout, res, forces = _run(profile="s1002_uic60", offset=0.002, t_end=0.01, n_out=1)
+    p = layout.parameters
+    weight = p.total_mass_kg * G
+    assert sum(layout.body_masses_kg.values()) == pytest.approx(p.total_mass_kg, rel=1e-15)
+    rate = momentum_rate_N(res, layout)[0]
+    q = sum(forces[n]["Q_N"][0] for n in layout.contact_names)
+    assert q == pytest.approx(weight + rate[2], rel=1e-9)    # 1e-16 measured
+    assert rate[2] == pytest.approx(-119.9, abs=0.1)         # not the weight: 452729.3 N against 452849.2 N
+    lateral = sum(forces[n]["lateral_N"][0] for n in layout.contact_names)
+    assert lateral == pytest.approx(rate[1], rel=1e-9)
+    assert lateral == pytest.approx(-3360, abs=1)            # toward the centre (the right, -y)
+    # The wheelsets carry it: each falls at dz/dy times its lateral acceleration, the rest is at rest.
+    dims = WheelsetDimensions(p.tape_circle_distance_m, p.nominal_rolling_radius_m)
+    z = [wheelset_on_track(layout.pair.wheel, layout.pair.rail, y, wheelset=dims).position_m[2]
+         for y in (0.002 - 1e-5, 0.002 + 1e-5)]
+    dz_dy = (z[1] - z[0]) / 2e-5
+    assert dz_dy == pytest.approx(0.0357, abs=1e-4)
+    for w in layout.wheelsets:
+        i = res.coordinate_names.index(f"{w}.x")
+        a_y, a_z = res.a[0, i + 1 : i + 3]
+        assert a_y == pytest.approx(-0.463, abs=1e-3), w
+        assert a_z == pytest.approx(dz_dy * a_y, rel=1e-3), w
+    others = [b for b in layout.body_masses_kg if b not in layout.wheelsets]
+    assert np.abs([res.a[0, res.coordinate_names.index(f"{b}.z")] for b in others]).max() < 1e-9
+
+
 def test_centred_vehicle_stays_symmetric_at_speed_on_s1002():
     layout, res, forces = _run(profile="s1002_uic60", t_end=0.2)
     for w in layout.wheelsets:
@@ -130,9 +165,10 @@ def test_vehicle_model_runs_and_summarizes(tmp_path):
         assert key in s, key
     assert len(s["wheel_names"]) == len(s["normal_force_static_N"]) == len(s["derailment_quotient_max"]) == 8
     assert len(s["lateral_displacement_max_m"]) == 4
-    # (to 1e-6 when centred, tested above; the offset wheelsets sit higher and rolled on S1002,
-    # so the preloaded suspensions start 120 N off the weight)
-    assert s["vertical_force_static_sum_N"] == pytest.approx(s["weight_N"], rel=1e-3)
+    # (the weight when centred; 2 mm off centre the wheelsets start falling: tested above)
+    assert s["vertical_force_static_sum_N"] == pytest.approx(s["weight_N"] + s["vertical_momentum_rate_static_N"],
+                                                             rel=1e-9)
+    assert s["vertical_momentum_rate_static_N"] == pytest.approx(-119.9, abs=0.1)
     # The wheelsets start 2 mm off centre and oscillate within it on tangent track.
     assert 0.0015 < max(s["lateral_displacement_max_m"]) < 0.0025
     assert 0.0 < max(s["derailment_quotient_max"]) < 0.2
