@@ -203,6 +203,10 @@ def main():
     from bench.dynamics import section as dynamics_section
 
     dynamics = dynamics_section(REPORT)
+    print("generalized-alpha against IDAS ...", flush=True)
+    from bench.generalized_alpha import section as alpha_section
+
+    alpha = alpha_section()
     print("pantograph/catenary ...", flush=True)
     from bench.pantograph import section as pantograph_section
 
@@ -269,6 +273,7 @@ def main():
         "",
         *startup,
         *dynamics,
+        *alpha,
         "",
         *pantograph,
         "",

@@ -7,7 +7,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from symcat.assembly.multibody import MultibodyModel
-from symcat.integrate import simulate
+from symcat.integrate.choice import integrate_model, integrator_parameters
 from symcat.model import Model, ModelOutput, Parameter
 from symcat.scene import Revolute, RigidBody, Scene
 
@@ -23,7 +23,7 @@ PARAMETERS = [
     Parameter("formulation", "augmented", "", "equations of motion", choices=("augmented", "embedded")),
     Parameter("index", "1", "", "index-1 with Baumgarte or stabilized index 2", choices=("1", "ggl")),
     Parameter("rtol", 1e-8, "-", "IDAS relative tolerance", minimum=1e-12, maximum=1e-2),
-]
+] + integrator_parameters()
 
 
 def rod(name, mass, length, centre, angle):
@@ -75,7 +75,8 @@ def run(p: dict) -> ModelOutput:
     if p["t_end"] == 0:
         tip = np.array(scene.rigid_bodies[1].position) + 0.5 * p["length"] * scene.rigid_bodies[1].rotation[:, 0]
         return ModelOutput({"tip_position_m": tip.tolist(), "energy_drift_rel": 0.0, "simulated_s": 0.0})
-    res = simulate(model, p["t_end"], p["formulation"], p["index"], rtol=p["rtol"], atol=p["rtol"] * 1e-2, n_out=100, progress=True)
+    res = integrate_model(model, p, p["t_end"], p["formulation"], p["index"], n_out=100, rtol=p["rtol"],
+                          atol=p["rtol"] * 1e-2)
     from symcat.scene.rigid import rotation_matrix
 
     off = model.rigid_offset["rod2"]

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from symcat.assembly.multibody import MultibodyModel
-from symcat.integrate import simulate
+from symcat.integrate.choice import integrate_model, integrator_parameters
 from symcat.model import Model, ModelOutput, Parameter
 from symcat.scene import AncfBody, Material, RigidBody, Scene, Section, SlidingJoint
 
@@ -32,7 +32,7 @@ PARAMETERS = [
     Parameter("rtol", 1e-6, "-", "IDAS relative tolerance", minimum=1e-12, maximum=1e-2),
     Parameter("window", 16, "-", "elements in the moving window of the sliding joint", minimum=2, maximum=100000),
     Parameter("cholesky", False, "", "Cholesky coordinates for the wire (identity mass matrix)"),
-]
+] + integrator_parameters()
 
 
 def build(p: dict) -> Scene:
@@ -64,8 +64,8 @@ def run(p: dict) -> ModelOutput:
     if p["t_end"] == 0:
         return ModelOutput({"s_final_m": p["s0"], "body_position_m": list(scene.rigid_bodies[0].position),
                             "max_position_drift_m": 0.0, "simulated_s": 0.0, "steps": 0})
-    res = simulate(model, p["t_end"], p["formulation"], p["index"], rtol=p["rtol"], atol=p["rtol"] * 1e-2,
-                   n_out=max(20, int(200 * p["t_end"])), cholesky=p["cholesky"])
+    res = integrate_model(model, p, p["t_end"], p["formulation"], p["index"], n_out=max(20, int(200 * p["t_end"])),
+                          rtol=p["rtol"], atol=p["rtol"] * 1e-2, cholesky=p["cholesky"])
     off = model.rigid_offset["body"]
     summary = {
         "s_final_m": float(res.s_m[-1, 0]),

@@ -186,7 +186,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
 
                 a = 0
                 while a < n_out:
-                    if _update_windows(model, form, x, z):
+                    if update_windows(model, form, x, z):
                         stats["restarts"] += 1
                         stepper.set_dae(dae_function())
                     b = min(n_out, a + group)
@@ -202,7 +202,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
                 b = _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges)
                 if limit is not None:
                     b = min(b, a + limit)
-                if _update_windows(model, form, x, z) or dae_fn is None:
+                if update_windows(model, form, x, z) or dae_fn is None:
                     stats["restarts"] += dae_fn is not None
                     dae_fn = dae_function()
                 try:
@@ -314,7 +314,7 @@ def _window_s(form, x, z) -> np.ndarray:
     return np.r_[parts["s"][: form.model.n_sliding], parts.get("sc", np.zeros(0))]
 
 
-def _update_windows(model, form, x, z) -> bool:
+def update_windows(model, form, x, z) -> bool:
     if not model.windowed():
         return False
     s = _window_s(form, x, z)

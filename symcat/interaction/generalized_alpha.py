@@ -13,13 +13,13 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from ..errors import ParameterError, SolverError
+from ..integrate.alpha_coefficients import AlphaCoefficients
 from ..progress import Progress
 from ..run_control import check_interrupt, ended_early, integrating
 from .banded import BandedCholesky
@@ -27,37 +27,10 @@ from .coupled import CoupledLine
 from .recorder import PassageRecorder
 
 
-@dataclass(frozen=True)
-class AlphaParameters:
-    """Generalized-alpha coefficients for spectral radius ``rho_inf`` at infinite frequency."""
-
-    rho_inf: float
-
-    def __post_init__(self):
-        if not 0.0 <= self.rho_inf <= 1.0:
-            raise ParameterError(f"rho_inf={self.rho_inf:g}: must be within 0..1")
-
-    @property
-    def alpha_m(self) -> float:
-        return (2 * self.rho_inf - 1) / (self.rho_inf + 1)
-
-    @property
-    def alpha_f(self) -> float:
-        return self.rho_inf / (self.rho_inf + 1)
-
-    @property
-    def gamma(self) -> float:
-        return 0.5 + self.alpha_f - self.alpha_m
-
-    @property
-    def beta(self) -> float:
-        return 0.25 * (self.gamma + 0.5) ** 2
-
-
 class _Stepper:
     """One step size: coefficients and the factorised iteration matrix."""
 
-    def __init__(self, line: CoupledLine, h: float, coef: AlphaParameters, stiffness=None):
+    def __init__(self, line: CoupledLine, h: float, coef: AlphaCoefficients, stiffness=None):
         self.h = h
         a_m, a_f = coef.alpha_m, coef.alpha_f
         self.beta_p = h * h * coef.beta * (1 - a_f) / (1 - a_m)
@@ -122,7 +95,7 @@ def integrate(line: CoupledLine, t_end: float, dt: float = 1e-3, rho_inf: float 
 def _integrate(line, t_end, dt, rho_inf, tol, max_iterations, record_every, progress, y0, contact_forces0):
     if not t_end >= 0:
         raise ParameterError(f"t_end={t_end:g} s: must be >= 0")
-    coef = AlphaParameters(rho_inf)
+    coef = AlphaCoefficients(rho_inf)
     wall0 = time.perf_counter()
     if y0 is None:
         y, fc = line.static_state()
@@ -195,7 +168,7 @@ def _substeps(line, coef, t, y, v, acc, a, lam, tol, max_iterations, h, sub):
     return y, v, acc, a, lam, states, iters_total
 
 
-def _step(line: CoupledLine, st: _Stepper, coef: AlphaParameters, t, y, v, acc, a, lam, tol, max_iterations,
+def _step(line: CoupledLine, st: _Stepper, coef: AlphaCoefficients, t, y, v, acc, a, lam, tol, max_iterations,
           acc_prev=None):
     """One generalized-alpha step from t to t + h; None if Newton does not converge.
 

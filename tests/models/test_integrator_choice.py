@@ -1,0 +1,50 @@
+"""The dynamic multibody models run on either integrator (the model parameter ``integrator``),
+and a combination that cannot run is one line naming it."""
+from __future__ import annotations
+
+import pytest
+
+from symcat import cli
+from symcat.errors import ParameterError
+from symcat.model import run_model
+
+
+def test_pendulum_on_generalized_alpha_meets_the_minimal_coordinate_reference_at_order_two():
+    errors = {}
+    for dt in (2e-3, 1e-3):
+        s = run_model("pendulum", {"t_end": 1.0, "integrator": "generalized_alpha", "index": "ggl", "dt": dt}).summary
+        errors[dt] = s["max_tip_error_m"]
+        assert s["max_position_drift_m"] < 1e-9 and s["stats"]["steps"] == pytest.approx(1.0 / dt, abs=1)
+    assert errors[1e-3] < 5e-5
+    assert 3.0 < errors[2e-3] / errors[1e-3] < 5.0  # second order
+
+
+def test_slider_on_wire_runs_the_same_on_both_integrators():
+    idas = run_model("slider_on_wire", {"t_end": 0.5}).summary
+    alpha = run_model("slider_on_wire", {"t_end": 0.5, "integrator": "generalized_alpha", "index": "ggl"}).summary
+    assert alpha["s_final_m"] == pytest.approx(idas["s_final_m"], abs=2e-6)
+    assert alpha["body_position_m"] == pytest.approx(idas["body_position_m"], abs=5e-5)
+    assert alpha["steps"] == 500 and alpha["max_position_drift_m"] < 1e-9
+
+
+@pytest.mark.parametrize("model, values, message", [
+    ("pendulum", {"formulation": "embedded"}, "formulation=embedded with integrator=generalized_alpha"),
+    ("slider_on_wire", {"formulation": "embedded"}, "use formulation=augmented, or integrator=idas"),
+])
+def test_a_combination_that_cannot_run_is_one_line(model, values, message, capsys, tmp_path):
+    sets = [f"{k}={v}" for k, v in {**values, "integrator": "generalized_alpha", "t_end": 0.01}.items()]
+    code = cli.main(["run", model, *sum((["--set", s] for s in sets), []), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and message in err[0], err
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(ParameterError, match="generalized_alpha"):
+        run_model(model, {**values, "integrator": "generalized_alpha", "t_end": 0.01})
+
+
+def test_wheel_rail_contacts_are_refused_by_generalized_alpha_with_their_names():
+    from symcat.integrate.choice import integrate_model
+    from tests.codegen.test_model_dae import _wheelset
+
+    p = {"integrator": "generalized_alpha", "dt": 1e-3, "rho_inf": 0.9}
+    with pytest.raises(ParameterError, match=r"not yet with wheel/rail or penalty contacts \(wr_left, wr_right\)"):
+        integrate_model(_wheelset(), p, 0.01, "augmented", "ggl")
