@@ -8,7 +8,7 @@ import numpy as np
 import scipy.sparse as sps
 
 from ..codegen.library import BufferedFunction, in_symbolic_kernels, kernel_library
-from ..scene.loads import NodalForce, SlopeMoment
+from ..scene.loads import NodalForce, NodalMass, SlopeMoment
 from ..scene.scene import Scene
 from .dofs import DofMap
 from .element_set import ElementSet
@@ -91,6 +91,10 @@ class System:
                 body = self.scene.body(load.body)
                 idx = self.dofs.node_indices(body, load.node)[: body.element.dim]
                 f[idx] += np.asarray(load.force, dtype=float)
+            elif isinstance(load, NodalMass):
+                body = self.scene.body(load.body)
+                idx = self.dofs.node_indices(body, load.node)[: body.element.dim]
+                f[idx] += load.mass * g[: body.element.dim]
         return f
 
     def constant_load(self) -> ca.DM:
@@ -172,6 +176,13 @@ class System:
         m = sps.csc_matrix((self.n, self.n))
         for es in self.element_sets:
             m = m + es.mass_matrix()
+        lumped = np.zeros(self.n)
+        for load in self.scene.loads:
+            if isinstance(load, NodalMass):
+                body = self.scene.body(load.body)
+                lumped[self.dofs.node_indices(body, load.node)[: body.element.dim]] += load.mass
+        if np.any(lumped):
+            m = m + sps.diags(lumped)
         return sps.csc_matrix(m)
 
     def external_force_value(self, q: np.ndarray) -> np.ndarray:

@@ -2,7 +2,8 @@
 from .design import CatenaryDesign, Wire
 from .formfinding import FormFindingResult, coupled_equilibrium, find_form
 from .reference import benchmark2015, en50318
+from .scene import catenary_scene
 from .structure import CatenaryStructure, stations
 
 __all__ = ["CatenaryDesign", "Wire", "CatenaryStructure", "stations", "find_form", "FormFindingResult",
-           "coupled_equilibrium", "benchmark2015", "en50318"]
+           "coupled_equilibrium", "benchmark2015", "en50318", "catenary_scene"]

@@ -3,13 +3,13 @@ from .ancf import AncfBody
 from .contact import PenaltyContact
 from .forces import Bushing, PointLoad, RotationalSpring, SpringDamper
 from .joints import GROUND, Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical
-from .loads import NodalForce, SlopeMoment
+from .loads import NodalForce, NodalMass, SlopeMoment
 from .rigid import RigidBody
 from .scene import Scene
 from .sections import Material, Section
 from .wheelrail import CreepModel, WheelRailJoint
 
 __all__ = [
-    "GROUND", "AncfBody", "Bushing", "CreepModel", "Driving", "Fixed", "Material", "NodalForce", "PenaltyContact", "PointLoad", "Prismatic", "Revolute",
+    "GROUND", "AncfBody", "Bushing", "CreepModel", "Driving", "Fixed", "Material", "NodalForce", "NodalMass", "PenaltyContact", "PointLoad", "Prismatic", "Revolute",
     "RigidBody", "RotationalSpring", "Scene", "Section", "SlidingJoint", "SlopeMoment", "Spherical", "SpringDamper", "WheelRailJoint",
 ]

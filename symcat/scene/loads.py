@@ -31,3 +31,13 @@ class SlopeMoment:
     def unit_axis(self) -> np.ndarray:
         a = np.asarray(self.axis, dtype=float)
         return a / np.linalg.norm(a)
+
+
+@dataclass(frozen=True)
+class NodalMass:
+    """A point mass (kg) on the position of a node of an ANCF body (a clamp, a steady arm):
+    a diagonal term on the node's position coordinates of the mass matrix, and its weight."""
+
+    body: str
+    node: int
+    mass: float

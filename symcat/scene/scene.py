@@ -11,7 +11,7 @@ from .ancf import AncfBody
 from .contact import PenaltyContact
 from .forces import Bushing, PointLoad, RotationalSpring, SpringDamper
 from .joints import Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical
-from .loads import NodalForce, SlopeMoment
+from .loads import NodalForce, NodalMass, SlopeMoment
 from .rigid import RigidBody
 from .wheelrail import WheelRailJoint
 
@@ -31,7 +31,7 @@ class Scene:
 
     gravity: tuple[float, float, float] = (0.0, 0.0, 0.0)
     bodies: list[AncfBody] = field(default_factory=list)
-    loads: list[NodalForce | SlopeMoment] = field(default_factory=list)
+    loads: list[NodalForce | NodalMass | SlopeMoment] = field(default_factory=list)
     rigid_bodies: list[RigidBody] = field(default_factory=list)
     joints: list = field(default_factory=list)
     force_elements: list = field(default_factory=list)
@@ -52,9 +52,11 @@ class Scene:
                 kind = "sliding joint" if isinstance(item, SlidingJoint) else "contact"
                 raise ParameterError(f"{kind} {item.name!r}: wire={item.wire!r} is not an ANCF body")
             (self.joints if isinstance(item, JOINT_TYPES) else self.force_elements).append(item)
-        elif isinstance(item, (NodalForce, SlopeMoment)):
+        elif isinstance(item, (NodalForce, NodalMass, SlopeMoment)):
             body = self.body(item.body)
             body.node_index(item.node)
+            if isinstance(item, NodalMass) and not (np.isfinite(item.mass) and item.mass >= 0):
+                raise ParameterError(f"nodal mass on ({item.body!r}, {item.node}): mass={item.mass:g} kg must be >= 0")
             if isinstance(item, NodalForce) and len(item.force) != body.element.dim:
                 raise ParameterError(
                     f"force={item.force}: body {body.name!r} is {body.element.dim}D, give {body.element.dim} components"
