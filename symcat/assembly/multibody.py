@@ -307,12 +307,24 @@ class MultibodyModel:
             m += MatrixScatter.square(idx, self.n_q, lib["rigid_mass"].sparsity_out(0))(blocks)
         return m
 
+    def _rayleigh_dm(self) -> ca.DM:
+        """The scene's Rayleigh damping matrix (:attr:`System.rayleigh_matrix`) over all
+        coordinates, as a constant CasADi sparse matrix (built once)."""
+        if getattr(self, "_rayleigh", None) is None:
+            c, n_a = self.ancf.rayleigh_matrix, self.ancf.n
+            if self.n_q > n_a:
+                c = sps.block_diag([c, sps.csc_matrix((self.n_q - n_a,) * 2)], format="csc")
+            self._rayleigh = to_casadi_sparse(c)
+        return self._rayleigh
+
     def forces(self, q: ca.MX, v: ca.MX, t: ca.MX) -> ca.MX:
-        """All applied, internal and quadratic-velocity forces (N, N m)."""
+        """All applied, internal and quadratic-velocity forces (N, N m), Rayleigh damping included."""
         n_a = self.ancf.n
         f = ca.MX(self.n_q, 1)
         if n_a:
             f += ca.vertcat(self.ancf.force_function()(q[:n_a], v[:n_a]), ca.MX(self.n_q - n_a, 1))
+            if self.ancf.rayleigh_matrix is not None:  # Rayleigh damping: constant sparse C times v
+                f -= ca.mtimes(self._rayleigh_dm(), v)
         if self.scene.rigid_bodies:
             bodies = self.scene.rigid_bodies
             idx = np.array([self._rigid_indices(b.name) for b in bodies])

@@ -12,7 +12,7 @@ from ..scene.loads import NodalForce, NodalMass, SlopeMoment
 from ..scene.scene import Scene
 from .dofs import DofMap
 from .element_set import ElementSet
-from .sparse import vector_scatter
+from .sparse import to_scipy, vector_scatter
 
 
 class System:
@@ -184,6 +184,31 @@ class System:
         if np.any(lumped):
             m = m + sps.diags(lumped)
         return sps.csc_matrix(m)
+
+    @cached_property
+    def rayleigh_matrix(self) -> sps.csc_matrix | None:
+        """Constant damping matrix ``C`` (N s/m) of the scene's
+        :class:`~symcat.scene.RayleighDamping` elements: ``alpha M + beta K0`` on each element's
+        bodies' coordinates (None without such elements). The damping force is ``-C v``."""
+        if not self.scene.damping:
+            return None
+        c = sps.csc_matrix((self.n, self.n))
+        for item in self.scene.damping:
+            idx = np.concatenate([np.arange(self.body_slice(name).start, self.body_slice(name).stop) for name in item.bodies])
+            k0 = item.stiffness_matrix()
+            if k0 is None and item.beta:
+                q = self.dofs.q0.copy()
+                if not isinstance(item.stiffness_at, str):
+                    q[idx] = np.asarray(item.stiffness_at, dtype=float)
+                qs = ca.MX.sym("q", self.n)
+                k0 = to_scipy(ca.DM(ca.Function("k0", [qs], [self.tangent_stiffness(qs)])(q))).tocsc()[idx][:, idx]
+            block = item.alpha * self.mass_matrix[idx][:, idx]
+            if item.beta:
+                block = block + item.beta * k0
+            block = sps.coo_matrix(block)
+            c = c + sps.csc_matrix((block.data, (idx[block.row], idx[block.col])), shape=(self.n, self.n))
+        c.eliminate_zeros()
+        return sps.csc_matrix(c)
 
     def external_force_value(self, q: np.ndarray) -> np.ndarray:
         return self._constant_load + (np.asarray(self._ext_fn(ca.DM(q))).ravel() if self._moments else 0.0)

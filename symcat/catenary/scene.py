@@ -25,11 +25,17 @@ supports                 metres straight above it: force ``preload - k (z - heig
                          preload (the spring leans, and adds a horizontal stiffness of
                          ``force / anchor``, only when the node moves along the line)
 stagger, overlaps        in the node positions (one pair of wires per tension section)
+Rayleigh damping         one :class:`RayleighDamping` on all wires: the damping
+                         matrix of :class:`~symcat.interaction.CoupledLine`, ``alpha M + beta
+                         K`` with ``M`` the structure's mass matrix (the scene's, wires and
+                         lumped masses) and ``K`` the structure's tangent stiffness at the static
+                         state ``form.q`` with every dropper taut, handed over as a constant
+                         matrix (``CatenaryStructure.stiffness(form.q, droppers_taut=True)``:
+                         wires, droppers, vertical supports; not the scene's own tangent, whose
+                         leaning support springs add ``force / anchor`` horizontally)
 =======================  =====================================================================
 
-Not expressed (yet): the Rayleigh damping ``alpha M + beta K`` of the design (the scene has no
-global Rayleigh damping; pass ``rayleigh="omit"`` to build without it, statics do not need it)
-and wires linearized with :meth:`CatenaryStructure.linearize_wires`.
+Not expressed (yet): wires linearized with :meth:`CatenaryStructure.linearize_wires`.
 """
 from __future__ import annotations
 
@@ -38,7 +44,7 @@ import copy
 import numpy as np
 
 from ..errors import ParameterError
-from ..scene import GROUND, NodalMass, Scene, SpringDamper
+from ..scene import GROUND, NodalMass, RayleighDamping, Scene, SpringDamper
 from .formfinding import FormFindingResult
 
 #: Height (m) of the ground anchor of each support spring above its node.
@@ -68,8 +74,8 @@ def catenary_scene(form: FormFindingResult, start: str = "static", rayleigh: str
         finding; :func:`~symcat.analysis.equilibrium.solve_equilibrium` then finds the static
         state).
     rayleigh : None or "omit"
-        The scene cannot carry the design's Rayleigh damping; with nonzero coefficients the
-        default refuses (ParameterError), ``"omit"`` builds the scene without it.
+        ``None`` (default): carry the design's Rayleigh damping (a :class:`RayleighDamping`
+        on all wires, when a coefficient is nonzero); ``"omit"``: build without it.
     anchor : float
         Height (m) of the support springs' ground points above their nodes.
     scene : Scene, optional
@@ -77,7 +83,8 @@ def catenary_scene(form: FormFindingResult, start: str = "static", rayleigh: str
 
     Element names: bodies as in the structure (``contact``, ``messenger``; ``contact_2`` ...
     with several sections), ``dropper_{i}`` (i in the order of ``structure.dropper_nodes``),
-    ``steady_arm_{j}`` and ``messenger_support_{j}`` (j in the order of ``cw_supports.nodes``).
+    ``steady_arm_{j}`` and ``messenger_support_{j}`` (j in the order of ``cw_supports.nodes``);
+    the Rayleigh damping, if any, is ``scene.damping[-1]``.
     The ANCF coordinates of the assembled scene are laid out as the structure's (same bodies in
     the same order), so ``q[:structure.n]`` indexes like ``form.q``.
     """
@@ -88,11 +95,7 @@ def catenary_scene(form: FormFindingResult, start: str = "static", rayleigh: str
     if start not in ("static", "mesh"):
         raise ParameterError(f"start={start!r}: must be 'static' or 'mesh'")
     if rayleigh not in (None, "omit"):
-        raise ParameterError(f"rayleigh={rayleigh!r}: must be None (refuse Rayleigh damping) or 'omit'")
-    if rayleigh is None and (d.rayleigh_alpha or d.rayleigh_beta):
-        raise ParameterError(
-            f"rayleigh_alpha={d.rayleigh_alpha:g} 1/s, rayleigh_beta={d.rayleigh_beta:g} s: a scene has no Rayleigh "
-            "damping yet; pass rayleigh='omit' to build the catenary scene without it (statics are unaffected)")
+        raise ParameterError(f"rayleigh={rayleigh!r}: must be None (carry the design's Rayleigh damping) or 'omit'")
     if getattr(st, "_linear", None) is not None:
         raise ParameterError("the structure's wires are linearized (linearize_wires); a scene carries the nonlinear "
                              "wires only: call structure.linearize_wires(None) first")
@@ -147,6 +150,12 @@ def catenary_scene(form: FormFindingResult, start: str = "static", rayleigh: str
             scene.add(SpringDamper(f"{prefix}_{j}", _node_ref(st, row, "cw" if xyz is st.cw_xyz else "mw"), GROUND,
                                    at_i=(x, y, z), at_j=top, stiffness=float(sup.stiffness),
                                    free_length=float(anchor - sup.preload[j] / sup.stiffness)))
+
+    # Rayleigh damping: the structure's C (see the module docstring).
+    if rayleigh is None and (d.rayleigh_alpha or d.rayleigh_beta):
+        scene.add(RayleighDamping(tuple(b.name for b in st.scene.bodies), float(d.rayleigh_alpha),
+                                  float(d.rayleigh_beta),
+                                  stiffness=st.stiffness(np.asarray(form.q, float), droppers_taut=True)))
     return scene
 
 

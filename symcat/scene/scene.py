@@ -9,6 +9,7 @@ import numpy as np
 from ..errors import ParameterError
 from .ancf import AncfBody
 from .contact import PenaltyContact
+from .damping import RayleighDamping
 from .forces import Bushing, PointLoad, RotationalSpring, SpringDamper
 from .joints import Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical
 from .loads import NodalForce, NodalMass, SlopeMoment
@@ -35,6 +36,7 @@ class Scene:
     rigid_bodies: list[RigidBody] = field(default_factory=list)
     joints: list = field(default_factory=list)
     force_elements: list = field(default_factory=list)
+    damping: list[RayleighDamping] = field(default_factory=list)
 
     def add(self, item):
         """Add a body, joint, force element or load and return it."""
@@ -62,9 +64,47 @@ class Scene:
                     f"force={item.force}: body {body.name!r} is {body.element.dim}D, give {body.element.dim} components"
                 )
             self.loads.append(item)
+        elif isinstance(item, RayleighDamping):
+            self._check_damping(item)
+            self.damping.append(item)
         else:
             raise ParameterError(f"cannot add {type(item).__name__} to a scene")
         return item
+
+    def _check_damping(self, item: RayleighDamping) -> None:
+        bodies = item.bodies
+        if isinstance(bodies, str) or not isinstance(bodies, (tuple, list)) or not bodies \
+                or not all(isinstance(b, str) for b in bodies):
+            raise ParameterError(f"RayleighDamping bodies={bodies!r}: must be a non-empty tuple of ANCF body names")
+        if len(set(bodies)) != len(bodies):
+            raise ParameterError(f"RayleighDamping bodies={tuple(bodies)!r}: a body is listed twice")
+        for name in bodies:
+            if not isinstance(self.find(name), AncfBody):
+                raise ParameterError(f"RayleighDamping bodies: {name!r} is a rigid body; only ANCF bodies are allowed")
+            for other in self.damping:
+                if name in other.bodies:
+                    raise ParameterError(f"RayleighDamping bodies: {name!r} is already damped by another RayleighDamping")
+        for field_name, unit in (("alpha", "1/s"), ("beta", "s")):
+            value = getattr(item, field_name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
+                    or not (np.isfinite(value) and value >= 0):
+                raise ParameterError(f"RayleighDamping {field_name}={value!r} {unit}: must be a finite number >= 0")
+        n = sum(self.body(name).q0.size for name in bodies)
+        if item.stiffness is not None:
+            shape = getattr(item.stiffness, "shape", None)
+            if shape != (n, n):
+                raise ParameterError(f"RayleighDamping stiffness: shape {shape}; must be ({n}, {n}), the bodies' coordinates")
+            if not np.all(np.isfinite(item.stiffness_matrix().data)):
+                raise ParameterError("RayleighDamping stiffness: has non-finite entries; must be finite")
+        elif not (isinstance(item.stiffness_at, str) and item.stiffness_at == "initial"):
+            at = item.stiffness_at
+            try:
+                ok = not isinstance(at, str) and np.shape(at) == (n,) and bool(np.all(np.isfinite(np.asarray(at, dtype=float))))
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                raise ParameterError(f"RayleighDamping stiffness_at={at if isinstance(at, str) else np.shape(at)!r}: "
+                                     f"must be 'initial' or {n} finite coordinates of the bodies")
 
     def body_names(self) -> list[str]:
         return [b.name for b in self.bodies] + [b.name for b in self.rigid_bodies]

@@ -8,7 +8,7 @@ from symcat.assembly.multibody import MultibodyModel
 from symcat.catenary import CatenaryStructure, benchmark2015, en50318, find_form
 from symcat.catenary.scene import catenary_scene, support_forces
 from symcat.errors import ParameterError
-from symcat.scene import AncfBody, Material, NodalForce, NodalMass, Scene, Section
+from symcat.scene import AncfBody, Material, NodalForce, NodalMass, RayleighDamping, RigidBody, Scene, Section
 
 SPANS, ELEMENTS = 3, 10
 
@@ -162,8 +162,8 @@ def test_other_designs(design, element, start):
 
 
 def test_unsupported_and_bad_inputs(form):
-    with pytest.raises(ParameterError, match="Rayleigh"):
-        catenary_scene(form)  # the benchmark's Rayleigh damping has no scene element yet
+    with pytest.raises(ParameterError, match="rayleigh="):
+        catenary_scene(form, rayleigh="keep")
     with pytest.raises(ParameterError, match="start="):
         catenary_scene(form, start="guess", rayleigh="omit")
     with pytest.raises(ParameterError, match="FormFindingResult"):
@@ -198,3 +198,126 @@ def test_nodal_mass_adds_mass_and_weight():
     np.testing.assert_allclose(np.diag(dm)[idx], 2.5)
     assert abs(dm).sum() == pytest.approx(7.5)
     np.testing.assert_allclose((system._constant_load - f0)[idx], [0.0, 0.0, -2.5 * 9.81])
+
+
+# --- Rayleigh damping --------------------------------------------------------------------------
+def _jacobians(model, q):
+    """``-dQ/dq`` and ``-dQ/dv`` of the assembled forces at ``(q, v = 0)`` (dense, all coordinates)."""
+    from symcat.assembly.sparse import to_scipy
+
+    qs, vs = ca.MX.sym("q", model.n_q), ca.MX.sym("v", model.n_q)
+    f = model.forces(qs, vs, ca.MX(0.0))
+    jq, jv = ca.Function("j", [qs, vs], [ca.jacobian(f, qs), ca.jacobian(f, vs)])(q, np.zeros(model.n_q))
+    return -to_scipy(jq).toarray(), -to_scipy(jv).toarray()
+
+
+def _structure_damping(st, q):
+    """CatenaryStructure's Rayleigh matrix as CoupledLine builds it (all coordinates)."""
+    d = st.design
+    return (d.rayleigh_alpha * st.mass_matrix + d.rayleigh_beta * st.stiffness(q, droppers_taut=True)).toarray()
+
+
+def test_rayleigh_damping_matrix_equals_the_structure(form):
+    st, d = form.structure, form.structure.design
+    assert d.rayleigh_alpha > 0 and d.rayleigh_beta > 0
+    scene = catenary_scene(form)  # default: carries the design's damping
+    (ray,) = scene.damping
+    assert ray.bodies == ("contact", "messenger") and (ray.alpha, ray.beta) == (d.rayleigh_alpha, d.rayleigh_beta)
+    _, c_scene = _jacobians(MultibodyModel(scene), form.q)
+    _, c_bare = _jacobians(MultibodyModel(catenary_scene(form, rayleigh="omit")), form.q)
+    c = c_scene - c_bare  # the dropper dampers (none in this design) cancel
+    c_st = _structure_damping(st, form.q)
+    f = st.free
+    assert np.abs(c_st).max() > 1.0
+    assert np.abs(c[np.ix_(f, f)] - c_st[np.ix_(f, f)]).max() <= 1e-12 * np.abs(c_st).max()
+    # the same matrix whatever the start: K0 is the structure's at the static state
+    _, c_mesh = _jacobians(MultibodyModel(catenary_scene(form, start="mesh")), form.q)
+    assert np.abs(c_mesh - c_scene).max() <= 1e-12 * np.abs(c_st).max()
+
+
+def test_rayleigh_free_decay(form):
+    """A small velocity along a ~10 Hz mode (IDAS, 0.5 s): the energy the run loses is the work
+    of ``v^T C v``, and the mode's energy decays at ``alpha + beta omega^2`` (twice the
+    amplitude rate ``alpha / 2 + beta omega^2 / 2``)."""
+    import scipy.linalg
+
+    from symcat.integrate.simulate import simulate
+
+    d = form.structure.design
+    model = MultibodyModel(catenary_scene(form))
+    f = model.free
+    k_all, c_all = _jacobians(model, form.q)
+    k, c = k_all[np.ix_(f, f)], c_all[np.ix_(f, f)]
+    m = model.ancf.mass_matrix.toarray()[np.ix_(f, f)]
+    w2, phi = scipy.linalg.eigh(0.5 * (k + k.T), m)
+    mode = int(np.argmin(np.abs(np.sqrt(np.abs(w2)) / (2 * np.pi) - 10.0)))
+    rate = d.rayleigh_alpha + d.rayleigh_beta * w2[mode]
+    assert phi[:, mode] @ c @ phi[:, mode] == pytest.approx(rate, rel=1e-6)  # nearly a modal damping
+    model.v0 = np.zeros(model.n_q)
+    model.v0[f] = 1e-3 * phi[:, mode] / np.abs(phi[:, mode]).max()
+    res = simulate(model, 0.5, rtol=1e-8, atol=1e-10, n_out=100, progress=False)
+    dq, v = res.q[:, f] - form.q[f], res.v[:, f]
+    energy = 0.5 * np.einsum("ti,ij,tj->t", v, m, v) + 0.5 * np.einsum("ti,ij,tj->t", dq, k, dq)
+    power = np.einsum("ti,ij,tj->t", v, c, v)
+    dissipated = np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(res.t_s))
+    assert power[0] == pytest.approx(model.v0[f] @ _structure_damping(form.structure, form.q)[np.ix_(f, f)] @ model.v0[f],
+                                     rel=1e-12)
+    assert energy[0] - energy[-1] == pytest.approx(dissipated, rel=2e-3)
+    assert dissipated > 0.1 * energy[0]
+    assert -np.polyfit(res.t_s, np.log(energy), 1)[0] == pytest.approx(rate, rel=1e-2)
+
+
+def test_rayleigh_at_initial_state_of_a_wire():
+    """``stiffness_at='initial'`` (the bodies' element stiffness at q0) and a given state."""
+    from symcat.assembly.sparse import to_scipy
+
+    scene = Scene(gravity=(0.0, 0.0, -9.81))
+    wire = AncfBody.straight("w", "cable3d", [0, 0, 0], [2, 0, 0], 4, Material(1e9, 1e3), Section.rectangle(0.01, 0.01),
+                             prestrain=1e-3)
+    scene.add(wire)
+    scene.add(NodalMass("w", 2, 0.5))
+    scene.add(RayleighDamping(("w",), 0.3, 2e-3))
+    model = MultibodyModel(scene)
+    sys_ = model.ancf
+    qs = ca.MX.sym("q", sys_.n)
+    k_fn = ca.Function("k", [qs], [sys_.tangent_stiffness(qs)])
+    expected = 0.3 * sys_.mass_matrix.toarray() + 2e-3 * to_scipy(ca.DM(k_fn(sys_.dofs.q0))).toarray()
+    _, c = _jacobians(model, model.q0)
+    assert np.abs(c - expected).max() <= 1e-12 * np.abs(expected).max()
+    bent = sys_.dofs.q0.copy()
+    bent[2::6] += 0.01 * np.sin(np.linspace(0, np.pi, bent[2::6].size))
+    at = Scene(gravity=scene.gravity)
+    at.add(wire)
+    at.add(RayleighDamping(("w",), 0.0, 2e-3, stiffness_at=bent))
+    np.testing.assert_allclose(MultibodyModel(at).ancf.rayleigh_matrix.toarray(),
+                               2e-3 * to_scipy(ca.DM(k_fn(bent))).toarray(), rtol=0, atol=1e-12 * np.abs(expected).max())
+
+
+def test_rayleigh_bad_inputs():
+    scene = Scene()
+    scene.add(AncfBody.straight("w", "cable3d", [0, 0, 0], [1, 0, 0], 2, Material(1e9, 1e3), Section.rectangle(0.01, 0.01)))
+    n = scene.bodies[0].q0.size
+    bad = [
+        (RayleighDamping((), 0.1, 0.0), "bodies=()"),
+        (RayleighDamping("w", 0.1, 0.0), "bodies='w'"),
+        (RayleighDamping(("w", "w"), 0.1, 0.0), "twice"),
+        (RayleighDamping(("x",), 0.1, 0.0), "body='x'"),
+        (RayleighDamping(("w",), -0.1, 0.0), "alpha=-0.1"),
+        (RayleighDamping(("w",), float("nan"), 0.0), "alpha=nan"),
+        (RayleighDamping(("w",), 0.1, -1e-3), "beta=-0.001"),
+        (RayleighDamping(("w",), 0.1, "0.1"), "beta='0.1'"),
+        (RayleighDamping(("w",), 0.1, 1e-3, stiffness=np.eye(3)), r"stiffness: shape \(3, 3\)"),
+        (RayleighDamping(("w",), 0.1, 1e-3, stiffness=np.full((n, n), np.inf)), "non-finite"),
+        (RayleighDamping(("w",), 0.1, 1e-3, stiffness_at="static"), "stiffness_at='static'"),
+        (RayleighDamping(("w",), 0.1, 1e-3, stiffness_at=np.zeros(3)), "stiffness_at=\\(3,\\)"),
+    ]
+    for item, message in bad:
+        with pytest.raises(ParameterError, match=message):
+            scene.add(item)
+    scene.add(RigidBody("r", 1.0, (1.0, 1.0, 1.0), (0.0, 0.0, 1.0)))
+    with pytest.raises(ParameterError, match="'r' is a rigid body"):
+        scene.add(RayleighDamping(("r",), 0.1, 0.0))
+    scene.add(RayleighDamping(("w",), 0.1, 0.0))
+    with pytest.raises(ParameterError, match="already damped"):
+        scene.add(RayleighDamping(("w",), 0.2, 0.0))
+    assert len(scene.damping) == 1
