@@ -36,7 +36,12 @@ Two variants (``variant``):
     is imposed as well, with the multiplier ``nu`` of the bracketed term; order 2 in positions,
     velocities and multipliers, at the price of ``n_c`` more unknowns.
 
-The Newton iteration solves for ``y = [u_{n+1}, beta h^2 lambda_{n+1} (, nu_{n+1})]`` with the
+Penalty contacts (:class:`symcat.scene.PenaltyContact`) add their arc lengths ``s_c`` as
+algebraic unknowns of each step with their tangency equations ``0 = T(q, s_c)`` (no multiplier;
+the normal forces are part of ``Q``), as in :class:`~symcat.dae.Formulation`. Wheel/rail contacts
+are not handled yet.
+
+The Newton iteration solves for ``y = [u_{n+1}, beta h^2 lambda_{n+1} (, nu_{n+1}), s_c]`` with the
 scaling of Bottasso, Bauchau and Cardona (2007, "Time-step-size-independent conditioning and
 sensitivity to perturbations in the numerical solution of index three differential algebraic
 equations", SIAM J Sci Comput 29:397-414): the dynamic rows are multiplied by ``beta h^2`` and
@@ -46,8 +51,16 @@ exact sparse Jacobian are CasADi functions of the step's unknowns and data, buil
 element window through :meth:`Formulation.terms` (separate functions, so that an iteration does
 not pay for the Jacobian). The iteration is a modified Newton one: the Jacobian is factorized
 (SuperLU) and kept across iterations and steps while the iteration contracts fast, and
-refactorized at the current iterate when it slows. The predictor extrapolates ``a`` and
-``lambda`` linearly from the last two steps.
+refactorized at the current iterate when it slows. The predictor extrapolates ``a``,
+``lambda`` and ``s_c`` linearly from the last two steps. A step whose iteration fails (even with
+a fresh matrix) is retried as two steps of half the size, each halved again on failure, down to
+``dt / 2**max_halvings``; the next step has the full size again (the Newmark variables are
+carried over unchanged across a change of step size).
+
+The starting value ``a_0 = v_dot(t_0 + (alpha_m - alpha_f) h)`` (order 2 from the first step) is
+filtered through the step's iteration matrix, so that modes the step does not resolve do not
+enter it (:meth:`_Integrator.starting_acceleration`; unfiltered, the cross-section modes of a
+beam3d wire made the first step of the seed paper's catenary diverge at dt = 1 ms).
 
 The states are mapped into the layout of the augmented index-1 form (``x = [q, s, v, w]``,
 ``z = [v_dot, s_ddot, lambda]``), so :func:`symcat.integrate.results.collect_result` makes the
@@ -86,9 +99,10 @@ SLOW_CONTRACTION = 0.3
 class AlphaRun:
     """What :func:`integrate_alpha` computed: outputs in the augmented index-1 layout of
     ``form`` (``xs``, ``zs``, see :meth:`Formulation.blocks`), the integrator's own multipliers
-    ``lambda_{n+1}`` (n_t, n_c) and statistics (``steps``, ``newton_iterations``,
-    ``factorizations``, ``rebuilds`` after element-window moves, ``build_s`` the wall time spent
-    building the step's functions, ``dt``, ``rho_inf``, ``variant``)."""
+    ``lambda_{n+1}`` (n_t, n_c) and statistics (``steps`` taken, halved ones included,
+    ``newton_iterations``, ``factorizations``, ``rebuilds`` after element-window moves,
+    ``halvings`` of failed steps, ``build_s`` the wall time spent building the step's functions,
+    ``dt``, ``rho_inf``, ``variant``)."""
 
     form: Formulation
     t_s: np.ndarray
@@ -109,13 +123,19 @@ class AlphaRun:
 class _Stepper:
     """The step equations of one element window: the scaled residual (with the updated ``a``,
     ``v`` and ``v_dot``) and its Jacobian as CasADi functions of the unknowns ``y`` and the
-    step's data ``p``, and the factorized iteration matrix of the modified Newton iteration."""
+    step's data ``p``, and the factorized iteration matrix of the modified Newton iteration.
+
+    ``y = [u, beta h^2 lambda (, nu), s_c]`` and the rows ``[dynamics, C_s^T lambda, C (, velocity
+    constraints), T]``: the arc lengths ``s_c`` of the penalty contacts are algebraic unknowns of
+    the step with their tangency rows ``T(q, s_c) = 0`` (no multiplier; their normal forces are
+    in ``Q``)."""
 
     def __init__(self, form: Formulation, variant: str, expand: bool = False):
-        n_f, n_s, n_c = form.n_f, form.n_s, form.n_c
-        self.n_u, self.n_c, self.n_s = n_f + n_s, n_c, n_s
+        n_f, n_s, n_c, n_sc = form.n_f, form.n_s, form.n_c, form.n_sc
+        self.n_u, self.n_c, self.n_s, self.n_sc = n_f + n_s, n_c, n_s, n_sc
         n_u = self.n_u
-        n_y = n_u + n_c * (2 if variant == "stabilized" else 1)
+        n_y = n_u + n_c * (2 if variant == "stabilized" else 1) + n_sc
+        self.n_y = n_y
         y = ca.MX.sym("y", n_y)
         # p: u_pred = u_n + h v_n + h^2 (1/2 - beta) a_n, v_pred = v_n + h (1 - gamma) a_n,
         # b = (alpha_m a_n - alpha_f v_dot_n) / (1 - alpha_f), then t_{n+1}, beta h^2, gamma h,
@@ -124,34 +144,38 @@ class _Stepper:
         u_pred, v_pred, b = p[:n_u], p[n_u : 2 * n_u], p[2 * n_u : 3 * n_u]
         t, bh2, gh, cm = p[3 * n_u], p[3 * n_u + 1], p[3 * n_u + 2], p[3 * n_u + 3]
         u, lam_s = y[:n_u], y[n_u : n_u + n_c]
+        sc = y[n_y - n_sc :] if n_sc else None
         q, s = u[:n_f], u[n_f:]
         shift = ca.MX.zeros(n_u)
         if variant == "stabilized":
-            nu = y[n_u + n_c :]
+            nu = y[n_u + n_c : n_u + 2 * n_c]
             # C_q and C_s depend on positions only: the velocities of this probe are immaterial.
-            g = self._terms(form, q, ca.MX.zeros(n_f), s, ca.MX.zeros(n_s), t)
+            g = self._terms(form, q, ca.MX.zeros(n_f), s, ca.MX.zeros(n_s), t, sc)
             shift = ca.vertcat(ca.mtimes(g["Cq"].T, nu), ca.mtimes(g["Cs"].T, nu))
         a = (u - u_pred - shift) / bh2
         v = v_pred + gh * a
         v_dot = cm * a + b
-        k = self._terms(form, q, v[:n_f], s, v[n_f:], t)
+        k = self._terms(form, q, v[:n_f], s, v[n_f:], t, sc)
         rows = [bh2 * (ca.mtimes(k["M"], v_dot[:n_f]) - k["Q"]) + ca.mtimes(k["Cq"].T, lam_s),
                 ca.mtimes(k["Cs"].T, lam_s), k["C"]]
         if variant == "stabilized":
             rows.append(bh2 / gh * (ca.mtimes(k["Cq"], v[:n_f]) + ca.mtimes(k["Cs"], v[n_f:]) + k["Ct"]))
+        rows.append(k["T"])
         r = ca.vertcat(*rows)
         self.residual_fn, self.update_fn, self.jacobian_fn = _step_functions(
             ca.Function("alpha_step", [y, p], [r, a, v, v_dot]), expand)
+        self.mass_fn = ca.Function("alpha_mass", [y], [k["M"]])
         self.lu = None
+        self.lu_bh2 = None  # the beta h^2 of the factorized matrix (a halved step refactorizes)
         self.factorizations = 0
         self.mass_scale = None  # kg: mean diagonal of M, converts multiplier updates to positions
 
     @staticmethod
-    def _terms(form, q, v, s, w, t):
+    def _terms(form, q, v, s, w, t, sc=None):
         if form.n_s == 0:  # an empty s would leave Cs 0 x 0 against n_c rows
-            k = form.terms(q, v, s, w, t)
+            k = form.terms(q, v, s, w, t, sc)
             return {**k, "Cs": ca.MX(form.n_c, 0)}
-        return form.terms(q, v, s, w, t)
+        return form.terms(q, v, s, w, t, sc)
 
     def residual(self, y, p) -> np.ndarray:
         return self.residual_fn(y, p).full().ravel()
@@ -160,17 +184,23 @@ class _Stepper:
         """``a``, ``v`` and ``v_dot`` at the end of the step whose unknowns are ``y``."""
         return tuple(x.full().ravel() for x in self.update_fn(y, p))
 
+    def mass(self, y) -> np.ndarray:
+        """The mass matrix (free coordinates, scipy sparse) at the positions of ``y``."""
+        return to_scipy(self.mass_fn(y))
+
     def factorize(self, y, p) -> None:
         jac = to_scipy(self.jacobian_fn(y, p))
         if self.mass_scale is None:
-            n_f = self.n_u - self.n_s
-            diag = np.abs(jac.diagonal()[:n_f]) / float(p[-1])  # (1 - alpha_m)/(1 - alpha_f) M on the diagonal
-            self.mass_scale = float(diag.mean()) if n_f and diag.mean() > 0 else 1.0
+            # The mass matrix's own diagonal: the iteration matrix's also holds beta h^2 K, which
+            # on the stiff cross-section gradients of a beam3d wire exceeds the mass by orders.
+            diag = np.abs(self.mass(y).diagonal())
+            self.mass_scale = float(diag.mean()) if diag.size and diag.mean() > 0 else 1.0
         try:
             self.lu = spla.splu(jac.tocsc())
         except RuntimeError:
             raise SolverError("generalized-alpha: singular iteration matrix (redundant constraints, or a sliding "
                               "joint at a point where its wire has no tangent?)") from None
+        self.lu_bh2 = float(p[3 * self.n_u + 1])
         self.factorizations += 1
 
 
@@ -191,9 +221,228 @@ def _step_functions(step: ca.Function, expand: bool) -> tuple[ca.Function, ca.Fu
         return fns
 
 
+@dataclass
+class _State:
+    """The integrator's state at one instant: ``u = [q, s]``, ``v``, ``v_dot``, the
+    acceleration-like ``a``, the multipliers ``lam`` and the contact arc lengths ``sc``; ``prev``
+    is ``(a, lam, sc)`` of the step before and ``h`` the step that led here (the predictor
+    extrapolates from them)."""
+
+    u: np.ndarray
+    v: np.ndarray
+    v_dot: np.ndarray
+    a: np.ndarray
+    lam: np.ndarray
+    sc: np.ndarray
+    prev: tuple
+    h: float
+
+
+class _StepFailure(Exception):
+    """A step whose Newton iteration failed at every allowed step size (from ``t0``, ``h`` the
+    smallest size tried)."""
+
+    def __init__(self, t0: float, h: float):
+        super().__init__(t0, h)
+        self.t0, self.h = t0, h
+
+
+class _Integrator:
+    """Steps of the generalized-alpha method on ``form`` (its :class:`_Stepper`, rebuilt when an
+    element window moves), halving a step whose Newton iteration fails."""
+
+    def __init__(self, model, form, coef, variant, tol, max_iterations, max_halvings, expand, stats):
+        self.model, self.form, self.coef, self.variant = model, form, coef, variant
+        self.tol, self.max_iterations, self.max_halvings, self.expand = tol, max_iterations, max_halvings, expand
+        self.stats = stats
+        self.xb, self.zb = form.blocks()
+        self.stepper = self._build()
+
+    def _build(self) -> _Stepper:
+        build = time.perf_counter()
+        stepper = _Stepper(self.form, self.variant, self.expand)
+        self.stats["build_s"] = self.stats.get("build_s", 0.0) + time.perf_counter() - build
+        return stepper
+
+    def data(self, s: _State, t0: float, h: float) -> np.ndarray:
+        """The step's data ``p`` (see :class:`_Stepper`) from ``s`` at ``t0`` over ``h``."""
+        c = self.coef
+        u_pred = s.u + h * s.v + h * h * (0.5 - c.beta) * s.a
+        v_pred = s.v + h * (1 - c.gamma) * s.a
+        b = (c.alpha_m * s.a - c.alpha_f * s.v_dot) / (1 - c.alpha_f)
+        return np.r_[u_pred, v_pred, b, t0 + h, c.beta * h * h, c.gamma * h, (1 - c.alpha_m) / (1 - c.alpha_f)]
+
+    def predictor(self, s: _State, p: np.ndarray, h: float) -> np.ndarray:
+        """``a``, ``lambda`` and ``s_c`` extrapolated linearly from the last two steps (one Newton
+        iteration fewer than ``a_{n+1} = a_n``), ``nu = 0``."""
+        st = self.stepper
+        n_u, n_c, n_sc = st.n_u, st.n_c, st.n_sc
+        bh2 = self.coef.beta * h * h
+        ratio = h / s.h
+        a_prev, lam_prev, sc_prev = s.prev
+        y = np.zeros(st.n_y)
+        y[:n_u] = p[:n_u] + bh2 * (s.a + ratio * (s.a - a_prev))
+        y[n_u : n_u + n_c] = bh2 * (s.lam + ratio * (s.lam - lam_prev))
+        if n_sc:
+            y[st.n_y - n_sc :] = s.sc + ratio * (s.sc - sc_prev)
+        return y
+
+    def attempt(self, s: _State, t0: float, h: float) -> _State | None:
+        """One step of size ``h`` from ``s`` at ``t0``; None if its Newton iteration fails."""
+        st = self.stepper
+        p = self.data(s, t0, h)
+        if st.lu is not None and st.lu_bh2 != p[3 * st.n_u + 1]:
+            st.lu = None  # factorized for another step size
+        done = _newton(st, self.predictor(s, p, h), p, st.n_u, st.n_c, st.n_sc, self.tol, self.max_iterations,
+                       self.stats)
+        if done is None:
+            return None
+        y, a, v, v_dot = done
+        bh2 = p[3 * st.n_u + 1]
+        sc = y[st.n_y - st.n_sc :].copy() if st.n_sc else np.zeros(0)
+        return _State(y[: st.n_u].copy(), v, v_dot, a, y[st.n_u : st.n_u + st.n_c] / bh2, sc, (s.a, s.lam, s.sc), h)
+
+    def advance(self, s: _State, t0: float, h: float, depth: int = 0) -> _State:
+        """The state at ``t0 + h``: one step, or, when its Newton iteration fails, two steps of
+        ``h / 2`` (each halved again on failure, at most :attr:`max_halvings` times in all)."""
+        new = self.attempt(s, t0, h)
+        if new is None:
+            if depth >= self.max_halvings:
+                raise _StepFailure(t0, h)
+            self.stats["halvings"] += 1
+            mid = self.advance(s, t0, 0.5 * h, depth + 1)
+            return self.advance(mid, t0 + 0.5 * h, 0.5 * h, depth + 1)
+        self.stats["steps"] += 1
+        self.stats["nsteps"] = self.stats["steps"]
+        x, z = self.layout(new)
+        if update_windows(self.model, self.form, x, z):
+            # The element windows are part of the equations' graph: rebuild them.
+            self.stats["factorizations"] += self.stepper.factorizations
+            self.stepper = self._build()
+            self.stats["rebuilds"] += 1
+        return new
+
+    def layout(self, s: _State):
+        """The state in the augmented index-1 layout ``x = [q, s, v, w]``, ``z = [a, s_dd, lambda(, sc)]``."""
+        n_f = self.form.n_f
+        values = {"q": s.u[:n_f], "s": s.u[n_f:], "v": s.v[:n_f], "w": s.v[n_f:], "a": s.v_dot[:n_f],
+                  "s_dd": s.v_dot[n_f:], "lambda": s.lam, "sc": s.sc}
+        x = np.zeros(sum(blk.size for blk in self.xb.values()))
+        z = np.zeros(sum(blk.size for blk in self.zb.values()))
+        for name, blk in self.xb.items():
+            x[blk.slice] = values[name]
+        for name, blk in self.zb.items():
+            z[blk.slice] = values[name]
+        return x, z
+
+    def start(self, x, z, h: float) -> _State:
+        """The state of the consistent ``(x, z)`` at t = 0, with the starting value of ``a``
+        (:meth:`starting_acceleration`) for steps of ``h``."""
+        xb, zb = self.xb, self.zb
+        u = np.r_[x[xb["q"].slice], x[xb["s"].slice]]
+        v = np.r_[x[xb["v"].slice], x[xb["w"].slice]]
+        v_dot = np.r_[z[zb["a"].slice], z[zb["s_dd"].slice]]
+        lam = z[zb["lambda"].slice].copy()
+        sc = z[zb["sc"].slice].copy() if "sc" in zb else np.zeros(0)
+        s = _State(u, v, v_dot, v_dot, lam, sc, (v_dot, lam, sc), h)
+        s.a = self.starting_acceleration(s, x, z, h)
+        s.prev = (s.a, lam, sc)
+        return s
+
+    def starting_acceleration(self, s: _State, x, z, h: float) -> np.ndarray:
+        """``a_0 = v_dot(t_0 + Delta)``, ``Delta = (alpha_m - alpha_f) h``: ``a_n`` approximates
+        ``v_dot`` at ``t_n + Delta`` to O(h^2) (Arnold and Brüls 2007), and starting it from
+        ``v_dot_0`` instead leaves an O(h) start-up error that decays slowly for rho_inf near 1
+        (measured on a spinning double pendulum, stabilized form: multiplier errors of order 1 in
+        dt instead of 2 over the first steps).
+
+        The correction ``delta = v_dot(t_0 + Delta) - v_dot_0`` is computed as the accelerations
+        of the consistent state at the Taylor-extrapolated positions and velocities (an O(h^2)
+        error), then filtered by the step's own iteration matrix: ``delta`` is replaced by the
+        solution of ``[J_uu, G^T; G, 0] [d; mu] = [c_m M delta; G delta]`` (``J_uu = c_m M +
+        gamma h D + beta h^2 K`` with the tangency rows of the penalty contacts, ``c_m = (1 -
+        alpha_m)/(1 - alpha_f)``), which passes what the step resolves (``omega h << 1``) to
+        O(h) and damps an unresolved mode by ``1 / (beta (omega h)^2)``. Unfiltered, a mode the
+        step cannot resolve makes ``a_0`` its jerk times ``Delta``: on the seed paper's
+        catenary (beam3d wire, cross-section gradient modes near 1e6 rad/s set vibrating by the
+        projected initial velocities, a jerk of 8e11 m/s^3) that was 4e7 m/s^2 at dt = 1 ms,
+        moved the predicted cross-section gradients (unit vectors) by 10, and the first step's
+        Newton iteration diverged."""
+        form, xb, zb, c = self.form, self.xb, self.zb, self.coef
+        shift = (c.alpha_m - c.alpha_f) * h
+        if shift == 0:
+            return s.v_dot
+        part = {name: x[blk.slice] for name, blk in xb.items()}
+        acc = {"q": z[zb["a"].slice], "s": z[zb["s_dd"].slice]}
+        start = {"q": part["q"] + shift * part["v"] + 0.5 * shift**2 * acc["q"], "v": part["v"] + shift * acc["q"],
+                 "s": part["s"] + shift * part["w"] + 0.5 * shift**2 * acc["s"], "w": part["w"] + shift * acc["s"],
+                 "sc": s.sc}
+        z1 = consistent_state(form, shift, start=start, positions=False)[1]
+        delta = np.r_[z1[zb["a"].slice], z1[zb["s_dd"].slice]] - s.v_dot
+        st = self.stepper
+        n_u, n_c, n_sc, n_f = st.n_u, st.n_c, st.n_sc, form.n_f
+        p = self.data(s, 0.0, h)
+        y = self.predictor(s, p, h)
+        keep = np.r_[np.arange(n_u + n_c), np.arange(st.n_y - n_sc, st.n_y)]
+        jac = to_scipy(st.jacobian_fn(y, p)).tocsr()[keep][:, keep].tocsc()
+        rhs = np.zeros(keep.size)
+        rhs[:n_f] = p[-1] * (st.mass(y) @ delta[:n_f])
+        rhs[n_u : n_u + n_c] = jac[n_u : n_u + n_c, :n_u] @ delta  # G delta
+        try:
+            filtered = spla.splu(jac).solve(rhs)[:n_u]
+        except RuntimeError:
+            raise SolverError("generalized-alpha: singular iteration matrix at the start (redundant constraints, "
+                              "or a sliding joint at a point where its wire has no tangent?)") from None
+        return s.v_dot + filtered
+
+
+def _newton(st: _Stepper, y0, p, n_u, n_c, n_sc, tol, max_iterations, stats, refreshed: bool = False):
+    """Modified Newton iteration of one step from the predictor ``y0``: the factorized matrix is
+    kept while the iteration contracts by at least :data:`SLOW_CONTRACTION` per iteration, else
+    refactorized at the current iterate. Converged when the last update, with the remaining
+    error estimated from the contraction rate, is below ``tol`` relative to the coordinates
+    (``1 + |u|``, and ``1 + |s_c|`` for the contact arc lengths); the scaled multipliers
+    ``beta h^2 lambda`` count as the position change ``beta h^2 lambda / m`` they cause on a mass
+    ``m`` (the mean diagonal of ``M``), and ``nu`` as a position change. Returns
+    ``(y, a, v, v_dot)`` or None."""
+    y = y0.copy()
+    fresh = refreshed or st.lu is None
+    if st.lu is None:
+        st.factorize(y, p)
+    n_y = y.size
+    scale = np.empty_like(y)
+    scale[:n_u] = tol * (1.0 + np.abs(y[:n_u]))
+    scale[n_u : n_u + n_c] = tol * st.mass_scale
+    scale[n_u + n_c : n_y - n_sc] = tol
+    scale[n_y - n_sc :] = tol * (1.0 + np.abs(y[n_y - n_sc :]))
+    previous = None
+    for _ in range(max_iterations):
+        r = st.residual(y, p)
+        dy = st.lu.solve(-r)
+        y += dy
+        stats["newton_iterations"] += 1
+        err = np.abs(dy / scale).max(initial=0.0)
+        theta = err / previous if previous else 0.0
+        if not np.isfinite(err):
+            return None
+        if err <= 1.0 and theta < 1.0 and theta / (1.0 - theta) * err <= 1.0 or err <= 1e-3:
+            return (y, *st.update(y, p))
+        if previous is not None and theta > SLOW_CONTRACTION:
+            if fresh and theta >= 1.0:
+                return None  # diverging with an up-to-date matrix
+            st.factorize(y, p)
+            fresh, previous = True, None
+            continue
+        previous = err
+    if not fresh:  # a last attempt with an up-to-date matrix from the predictor
+        st.factorize(y0, p)
+        return _newton(st, y0, p, n_u, n_c, n_sc, tol, max_iterations, stats, refreshed=True)
+    return None
+
+
 def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: float = 0.9,
                     variant: str = "stabilized", tol: float = 1e-10, max_iterations: int = 20, n_out: int = 200,
-                    progress: bool = True, expand: bool = False) -> AlphaRun:
+                    progress: bool = True, expand: bool = False, max_halvings: int = 4) -> AlphaRun:
     """Integrate ``model`` from its consistent initial state to ``t_end`` with fixed steps.
 
     Parameters are those of :func:`generalized_alpha`.
@@ -216,12 +465,13 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
         raise ParameterError(f"n_out={n_out!r}: must be >= 1")
     if int(max_iterations) < 1:
         raise ParameterError(f"max_iterations={max_iterations!r}: must be >= 1")
-    if model.wheelrail or model.n_sc:
-        raise ParameterError("generalized-alpha does not handle wheel/rail or penalty contacts yet; use simulate() "
-                             "(IDAS) for this model")
+    if not (isinstance(max_halvings, int) and 0 <= max_halvings <= 20):
+        raise ParameterError(f"max_halvings={max_halvings!r}: must be an integer in 0..20")
+    if model.wheelrail:
+        raise ParameterError("generalized-alpha does not handle wheel/rail contacts yet; use simulate() (IDAS) for "
+                             "this model")
     wall0 = time.perf_counter()
     form = Formulation(model, "augmented", "1")
-    xb, zb = form.blocks()
     x, z = consistent_state(form, 0.0)
     # Equal steps no longer than dt, a whole number of them per output interval.
     n_steps = max(1, math.ceil(t_end / dt - 1e-9))
@@ -229,72 +479,42 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
     n_outputs = math.ceil(n_steps / per)
     n_steps = n_outputs * per
     h = t_end / n_steps
-    a_m, a_f, beta, gamma = coef.alpha_m, coef.alpha_f, coef.beta, coef.gamma
-    bh2, gh, cm = beta * h * h, gamma * h, (1 - a_m) / (1 - a_f)
-
-    n_f, n_s, n_c = form.n_f, form.n_s, form.n_c
-    u = np.r_[x[xb["q"].slice], x[xb["s"].slice]]
-    v = np.r_[x[xb["v"].slice], x[xb["w"].slice]]
-    v_dot = np.r_[z[zb["a"].slice], z[zb["s_dd"].slice]]
-    lam = z[zb["lambda"].slice].copy()
-    a = _starting_acceleration(form, xb, zb, x, z, (a_m - a_f) * h)
-    a_prev, lam_prev = a, lam
-    n_y = n_f + n_s + n_c * (2 if variant == "stabilized" else 1)
-    y = np.zeros(n_y)
 
     t_s = np.linspace(0.0, t_end, n_outputs + 1)
-    run = AlphaRun(form, t_s, [x], [z], np.zeros((n_outputs + 1, n_c)), walls=[time.perf_counter() - wall0])
-    run.multipliers[0] = lam
+    run = AlphaRun(form, t_s, [x], [z], np.zeros((n_outputs + 1, form.n_c)), walls=[time.perf_counter() - wall0])
     stats = run.stats
-    stats.update(steps=0, nsteps=0, newton_iterations=0, factorizations=0, rebuilds=0, dt=h, rho_inf=coef.rho_inf,
-                 variant=variant)
-    build = time.perf_counter()
-    stepper = _Stepper(form, variant, expand)
-    stats["build_s"] = time.perf_counter() - build
+    stats.update(steps=0, nsteps=0, newton_iterations=0, factorizations=0, rebuilds=0, halvings=0, build_s=0.0,
+                 dt=h, rho_inf=coef.rho_inf, variant=variant)
+    integ = _Integrator(model, form, coef, variant, tol, int(max_iterations), max_halvings, expand, stats)
+    state = integ.start(x, z, h)
+    run.multipliers[0] = state.lam
     bar = Progress("generalized-alpha", t_end, "s", enabled=progress)
     step = 0
     try:
         with integrating():
             for out in range(1, n_outputs + 1):
                 for _ in range(per):
-                    t1 = (step + 1) * h
-                    u_pred = u + h * v + h * h * (0.5 - beta) * a
-                    v_pred = v + h * (1 - gamma) * a
-                    b = (a_m * a - a_f * v_dot) / (1 - a_f)
-                    p = np.r_[u_pred, v_pred, b, t1, bh2, gh, cm]
-                    # Predictor: a and lambda extrapolated linearly from the last two steps
-                    # (one Newton iteration fewer than a_{n+1} = a_n), nu = 0.
-                    y[: n_f + n_s] = u_pred + bh2 * (2 * a - a_prev)
-                    y[n_f + n_s : n_f + n_s + n_c] = bh2 * (2 * lam - lam_prev)
-                    y[n_f + n_s + n_c :] = 0.0
-                    done = _newton(stepper, y, p, n_f + n_s, n_c, tol, max_iterations, stats)
-                    if done is None:
+                    try:
+                        state = integ.advance(state, step * h, h)
+                    except _StepFailure as fail:
+                        t1 = (step + 1) * h
+                        tried = (f"nor with the step halved {max_halvings} times (the last try, {fail.h:.3g} s "
+                                 f"from t = {fail.t0:.6g} s, failed too)" if max_halvings else
+                                 "and halving the step was not allowed (max_halvings=0)")
                         raise SolverError(f"generalized-alpha: Newton did not converge in the step to t = {t1:.6g} s "
-                                          f"(dt = {h:.3g} s) even with a fresh Jacobian; try a smaller dt or a "
-                                          "smaller rho_inf; the results so far are in .partial")
-                    a_prev, lam_prev = a, lam
-                    y, a, v, v_dot = done
-                    u = y[: n_f + n_s].copy()
-                    lam = y[n_f + n_s : n_f + n_s + n_c] / bh2
+                                          f"(dt = {h:.3g} s) even with a fresh Jacobian, {tried}; try a smaller dt "
+                                          "or a smaller rho_inf; the results so far are in .partial") from None
                     step += 1
-                    stats["steps"] = stats["nsteps"] = step
-                    x, z = _layout(xb, zb, u, v, v_dot, lam, n_f)
-                    if update_windows(model, form, x, z):
-                        # The element windows are part of the equations' graph: rebuild them.
-                        stats["factorizations"] += stepper.factorizations
-                        build = time.perf_counter()
-                        stepper = _Stepper(form, variant, expand)
-                        stats["build_s"] += time.perf_counter() - build
-                        stats["rebuilds"] += 1
+                x, z = integ.layout(state)
                 run.xs.append(x)
                 run.zs.append(z)
-                run.multipliers[out] = lam
+                run.multipliers[out] = state.lam
                 run.walls.append(time.perf_counter() - wall0)
                 bar.update(t_s[out])
                 check_interrupt(t_s[out], t_end)
     except SolverError as err:
         bar.close()
-        stats["factorizations"] += stepper.factorizations
+        stats["factorizations"] += integ.stepper.factorizations
         stats["wall_s"] = time.perf_counter() - wall0
         run.multipliers = run.multipliers[: len(run.xs)]
         err.partial = run
@@ -302,98 +522,26 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
             return run
         raise
     bar.close()
-    stats["factorizations"] += stepper.factorizations
+    stats["factorizations"] += integ.stepper.factorizations
     stats["wall_s"] = time.perf_counter() - wall0
     return run
 
 
-def _starting_acceleration(form, xb, zb, x, z, shift) -> np.ndarray:
-    """``a_0 = v_dot(t_0 + (alpha_m - alpha_f) h)``: ``a_n`` approximates ``v_dot`` at
-    ``t_n + (alpha_m - alpha_f) h`` to O(h^2) (Arnold and Brüls 2007), and starting it from
-    ``v_dot_0`` instead leaves an O(h) start-up error that decays slowly for rho_inf near 1
-    (measured on a spinning double pendulum, stabilized form: multiplier errors of order 1 in
-    dt instead of 2 over the first steps). Computed as the accelerations of the consistent
-    state at the Taylor-extrapolated positions and velocities (an O(h^2) error, enough)."""
-    if shift == 0:
-        return np.r_[z[zb["a"].slice], z[zb["s_dd"].slice]]
-    part = {name: x[blk.slice] for name, blk in xb.items()}
-    acc = {"q": z[zb["a"].slice], "s": z[zb["s_dd"].slice]}
-    start = {"q": part["q"] + shift * part["v"] + 0.5 * shift**2 * acc["q"], "v": part["v"] + shift * acc["q"],
-             "s": part["s"] + shift * part["w"] + 0.5 * shift**2 * acc["s"], "w": part["w"] + shift * acc["s"],
-             "sc": np.zeros(form.n_sc)}
-    z1 = consistent_state(form, shift, start=start, positions=False)[1]
-    return np.r_[z1[zb["a"].slice], z1[zb["s_dd"].slice]]
-
-
-def _newton(st: _Stepper, y0, p, n_u, n_c, tol, max_iterations, stats, refreshed: bool = False):
-    """Modified Newton iteration of one step from the predictor ``y0``: the factorized matrix is
-    kept while the iteration contracts by at least :data:`SLOW_CONTRACTION` per iteration, else
-    refactorized at the current iterate. Converged when the last update, with the remaining
-    error estimated from the contraction rate, is below ``tol`` relative to the coordinates
-    (``1 + |u|``); the scaled multipliers ``beta h^2 lambda`` count as the position change
-    ``beta h^2 lambda / m`` they cause on a mass ``m`` (the mean diagonal of ``M``), and ``nu``
-    as a position change. Returns ``(y, a, v, v_dot)`` or None."""
-    y = y0.copy()
-    fresh = refreshed or st.lu is None
-    if st.lu is None:
-        st.factorize(y, p)
-    scale = np.empty_like(y)
-    scale[:n_u] = tol * (1.0 + np.abs(y[:n_u]))
-    scale[n_u : n_u + n_c] = tol * st.mass_scale
-    scale[n_u + n_c :] = tol
-    previous = None
-    for _ in range(max_iterations):
-        r = st.residual(y, p)
-        dy = st.lu.solve(-r)
-        y += dy
-        stats["newton_iterations"] += 1
-        err = np.abs(dy / scale).max(initial=0.0)
-        theta = err / previous if previous else 0.0
-        if not np.isfinite(err):
-            return None
-        if err <= 1.0 and theta < 1.0 and theta / (1.0 - theta) * err <= 1.0 or err <= 1e-3:
-            return (y, *st.update(y, p))
-        if previous is not None and theta > SLOW_CONTRACTION:
-            if fresh and theta >= 1.0:
-                return None  # diverging with an up-to-date matrix
-            st.factorize(y, p)
-            fresh, previous = True, None
-            continue
-        previous = err
-    if not fresh:  # a last attempt with an up-to-date matrix from the predictor
-        st.factorize(y0, p)
-        return _newton(st, y0, p, n_u, n_c, tol, max_iterations, stats, refreshed=True)
-    return None
-
-
-def _layout(xb, zb, u, v, v_dot, lam, n_f):
-    """The state in the augmented index-1 layout ``x = [q, s, v, w]``, ``z = [a, s_dd, lambda]``."""
-    values = {"q": u[:n_f], "s": u[n_f:], "v": v[:n_f], "w": v[n_f:], "a": v_dot[:n_f], "s_dd": v_dot[n_f:],
-              "lambda": lam}
-    x = np.zeros(sum(blk.size for blk in xb.values()))
-    z = np.zeros(sum(blk.size for blk in zb.values()))
-    for name, blk in xb.items():
-        x[blk.slice] = values[name]
-    for name, blk in zb.items():
-        z[blk.slice] = values[name]
-    return x, z
-
-
 def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: float = 0.9,
                       variant: str = "stabilized", tol: float = 1e-10, max_iterations: int = 20, n_out: int = 200,
-                      progress: bool = True, expand: bool = False) -> SimulationResult:
+                      progress: bool = True, expand: bool = False, max_halvings: int = 4) -> SimulationResult:
     """Simulate ``model`` from 0 to ``t_end`` seconds by the generalized-alpha method (fixed step).
 
     Parameters
     ----------
     model : MultibodyModel
-        Rigid bodies, ANCF wires, joints and sliding joints (element windows move between steps,
-        as in :func:`simulate`); not yet wheel/rail or penalty contacts.
+        Rigid bodies, ANCF wires, joints, sliding joints and penalty contacts (element windows
+        move between steps, as in :func:`simulate`); not yet wheel/rail contacts.
     t_end : float
         Simulated time (s), > 0.
     dt : float
         Time step (s), > 0; the run takes equal steps no longer than ``dt``, a whole number of
-        them per output interval.
+        them per output interval (a step that fails is halved, see ``max_halvings``).
     rho_inf : float
         Spectral radius at infinite frequency, 0..1: 1 keeps every frequency undamped (and
         energy bounded), smaller values damp the content the step does not resolve (0.9 costs
@@ -408,6 +556,10 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
         error (on the double pendulum at dt = 1 ms, 1e-8 tripled the error at 2 s; 1e-10 left it).
     max_iterations : int
         Newton iterations per step; past them the matrix is refreshed once, then the step fails.
+    max_halvings : int
+        A step whose Newton iteration fails is retried as two steps of half the size, each
+        halved again on failure, down to ``dt / 2**max_halvings`` (default 1/16); the next step
+        has the full size again, so the outputs stay on the ``dt`` grid. 0: no retry.
     n_out : int
         Output intervals (at most one per step).
     progress : bool
@@ -421,19 +573,21 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
     -------
     SimulationResult
         As :func:`simulate` returns it; ``stats`` has ``steps``, ``newton_iterations``,
-        ``factorizations``, ``rebuilds``, ``build_s``, ``dt``, ``rho_inf``, ``variant``, ``wall_s``
-        (see :class:`AlphaRun`).
+        ``factorizations``, ``rebuilds``, ``halvings``, ``build_s``, ``dt``, ``rho_inf``,
+        ``variant``, ``wall_s`` (see :class:`AlphaRun`).
 
     Raises
     ------
     ParameterError
         Naming the parameter out of range.
     SolverError
-        When a step's Newton iteration fails; ``partial`` holds the result so far.
+        When a step's Newton iteration fails at every size down to ``dt / 2**max_halvings``
+        (the message names the step and the last size tried); ``partial`` holds the result so far.
     """
     wall0 = time.perf_counter()
     try:
-        run = integrate_alpha(model, t_end, dt, rho_inf, variant, tol, max_iterations, n_out, progress, expand)
+        run = integrate_alpha(model, t_end, dt, rho_inf, variant, tol, max_iterations, n_out, progress, expand,
+                              max_halvings)
     except SolverError as err:
         if isinstance(err.partial, AlphaRun):
             err.partial = err.partial.result(wall0)

@@ -1,7 +1,8 @@
 """The generalized-alpha integrator of the multibody formulation
 (:mod:`symcat.integrate.generalized_alpha`) against IDAS: convergence orders on a rigid double
 pendulum, bounded energy without numerical dissipation, a body on a sliding joint on a flexible
-wire, element windows moving between steps, and its parameter checks."""
+wire, element windows moving between steps, penalty contacts, the start on a stiff beam3d
+catenary, halving of failed steps, and its parameter checks."""
 from __future__ import annotations
 
 import importlib.util
@@ -15,6 +16,7 @@ from symcat.integrate import simulate
 from symcat.integrate.generalized_alpha import generalized_alpha, integrate_alpha
 from symcat.model import model_path
 from symcat.scene import AncfBody, Material, RigidBody, Scene, Section, SlidingJoint
+from tests.dynamics.test_contact import head_under_wire
 
 G = 9.81
 
@@ -186,7 +188,8 @@ def test_element_windows_move_between_steps():
 @pytest.mark.parametrize("kwargs, name", [({"dt": 0.0}, "dt"), ({"dt": -1e-3}, "dt"), ({"dt": float("nan")}, "dt"),
                                           ({"rho_inf": -0.1}, "rho_inf"), ({"rho_inf": 1.5}, "rho_inf"),
                                           ({"variant": "index2"}, "variant"), ({"t_end": 0.0}, "t_end"),
-                                          ({"max_iterations": 0}, "max_iterations")])
+                                          ({"max_iterations": 0}, "max_iterations"),
+                                          ({"max_halvings": -1}, "max_halvings")])
 def test_bad_parameters_are_named(kwargs, name):
     args = {"t_end": 1.0, "dt": 1e-3, **kwargs}
     with pytest.raises(ParameterError, match=rf"^{name}="):
@@ -194,9 +197,86 @@ def test_bad_parameters_are_named(kwargs, name):
 
 
 def test_a_failed_step_keeps_the_result_so_far():
-    """One Newton iteration per step cannot converge from a step of 0.1 s: the error names the
-    time and the step, and carries the outputs computed before it as a SimulationResult."""
-    with pytest.raises(SolverError, match=r"t = 0\.1 s \(dt = 0\.1 s\)") as info:
+    """One Newton iteration per step cannot converge from a step of 0.1 s, nor from its halves
+    down to 0.1 s / 16: the error names the time, the step and the smallest step tried, and
+    carries the outputs computed before it as a SimulationResult."""
+    with pytest.raises(SolverError, match=r"t = 0\.1 s \(dt = 0\.1 s\).*halved 4 times \(the last try, 0\.00625 s "
+                                          r"from t = 0 s") as info:
         generalized_alpha(pendulum(), 1.0, 0.1, max_iterations=1, n_out=10, progress=False)
     partial = info.value.partial
     assert partial.t_s.tolist() == [0.0] and partial.q.shape == (1, pendulum().n_q)
+    assert partial.stats["halvings"] == 4
+
+
+def test_a_step_whose_newton_iteration_fails_is_halved():
+    """Four Newton iterations per step are too few for some 20 ms steps of the double pendulum:
+    those are taken as two (or more) shorter steps, the next step has the full size again (the
+    outputs stay on the dt grid), and the motion is that of the run allowed 20 iterations; with
+    halving forbidden the run fails, naming it."""
+    ref = simulate(pendulum(), 1.0, rtol=1e-10, atol=1e-12, n_out=10, progress=False)
+    plain = generalized_alpha(pendulum(), 1.0, 0.02, n_out=10, progress=False)
+    halved = generalized_alpha(pendulum(), 1.0, 0.02, max_iterations=4, n_out=10, progress=False)
+    assert plain.stats["halvings"] == 0 and plain.stats["steps"] == 50
+    assert halved.stats["halvings"] >= 3
+    assert halved.stats["steps"] == 50 + halved.stats["halvings"]  # each halving: one step more
+    np.testing.assert_allclose(halved.t_s, plain.t_s)
+    err_plain, err_halved = np.abs(plain.q - ref.q).max(), np.abs(halved.q - ref.q).max()
+    print(f"halvings {halved.stats['halvings']}: errors {err_halved:.3g} (halved) {err_plain:.3g} (plain)")
+    assert err_halved < 1.1 * err_plain and np.abs(halved.q - plain.q).max() < 0.5 * err_plain
+    with pytest.raises(SolverError, match=r"halving the step was not allowed \(max_halvings=0\)") as info:
+        generalized_alpha(pendulum(), 1.0, 0.02, max_iterations=4, max_halvings=0, n_out=10, progress=False)
+    assert 1 <= info.value.partial.t_s.size < 11
+
+
+def test_a_stiff_beam3d_catenary_starts_at_one_millisecond():
+    """The seed paper's catenary (beam3d wire under tension with droppers, the pantograph on a
+    sliding joint): the projected initial velocities set the wire's cross-section gradient modes
+    (near 1e6 rad/s) vibrating, and the start-up value a_0 = v_dot(t_0 + (alpha_m - alpha_f) h),
+    unfiltered, carried their jerk (4e7 m/s^2 at dt = 1 ms): the first step's Newton iteration
+    diverged. Filtered through the step's iteration matrix, the steps converge in a few
+    iterations and the pan-head's a_0 stays its resolved acceleration."""
+    module = _scene_module("seo2005_catenary")
+    from symcat.analysis.equilibrium import solve_equilibrium
+
+    model = MultibodyModel(module.build(_defaults(module)))
+    solve_equilibrium(model).apply(model)
+    for variant in ("stabilized", "index3"):
+        run = integrate_alpha(model, 0.02, 1e-3, variant=variant, n_out=2, progress=False)
+        stats = run.stats
+        assert stats["steps"] == 20 and stats["halvings"] == 0, stats
+        assert stats["newton_iterations"] <= 6 * stats["steps"], stats
+    res = run.result()
+    # The pan-head is pushed down by the wire (about 74 N at 17 m/s) and stays on it.
+    force = -res.reactions_N["contact"][:, 2]
+    assert np.all((force > 50) & (force < 100)), force
+
+
+def test_penalty_contact_matches_idas_at_order_two():
+    """A head pushed against a pretensioned cable by 60 N plus 30 N at 8 Hz through a penalty
+    contact (its arc length an algebraic unknown of each step, with its tangency row): position,
+    contact force and contact arc length agree with IDAS, the error falling like dt^2."""
+    ref = simulate(head_under_wire(shake=30.0)[0], 0.3, rtol=1e-8, atol=1e-10, n_out=30, progress=False)
+    off = head_under_wire(shake=30.0)[0].rigid_offset["head"] + 2
+    z_err, f_err = [], []
+    for dt in (2e-3, 1e-3):
+        res = generalized_alpha(head_under_wire(shake=30.0)[0], 0.3, dt, n_out=30, progress=False)
+        c, c_ref = res.contacts["contact"], ref.contacts["contact"]
+        z_err.append(np.abs(res.q[:, off] - ref.q[:, off]).max())
+        f_err.append(np.abs(c["force_N"] - c_ref["force_N"]).max())
+        assert np.abs(c["s_m"] - c_ref["s_m"]).max() < 5e-6
+    print(f"penalty: head z errors {z_err} m, force errors {f_err} N (dt = 2, 1 ms)")
+    assert z_err[-1] < 3e-5 and f_err[-1] < 0.005 * np.ptp(c_ref["force_N"])  # of 43 mm, 49 N
+    assert z_err[0] / z_err[1] > 3 and f_err[0] / f_err[1] > 3
+
+
+def test_penalty_contact_is_lost_and_regained_as_on_idas():
+    """The head launched downward at 2 m/s leaves the wire and lands on it again, several times
+    in 0.3 s: the time out of contact and the motion are those of IDAS; no force while apart."""
+    ref = simulate(head_under_wire(v0=-2.0)[0], 0.3, rtol=1e-8, atol=1e-10, n_out=60, progress=False)
+    res = generalized_alpha(head_under_wire(v0=-2.0)[0], 0.3, 1e-3, n_out=60, progress=False)
+    c, c_ref = res.contacts["contact"], ref.contacts["contact"]
+    off = head_under_wire()[0].rigid_offset["head"] + 2
+    assert abs((c["gap_m"] > 0).mean() - (c_ref["gap_m"] > 0).mean()) < 0.05
+    assert (c_ref["gap_m"] > 0).mean() > 0.1
+    assert np.abs(res.q[:, off] - ref.q[:, off]).max() < 0.005 * np.ptp(ref.q[:, off])
+    assert np.all(c["force_N"] >= 0) and np.all(c["force_N"][c["gap_m"] > 0] == 0)
