@@ -5,8 +5,10 @@ vehicle with wheel/rail contacts carrying the four-body pantograph on its roof, 
 The vehicle is :mod:`symcat.vehicle` (as ``models/vehicle.py``: car body, two bogies with frames,
 bolsters, equalizer bars and wheelsets; constraint wheel/rail contact, seed eq. 22, with creep
 forces; the leading wheelset of each bogie driven at ``speed``, as in the paper). The catenary,
-the pantograph and the pan-head/wire contact are those of ``models/seo2005_catenary.py`` (see
-its docstring for every dimension chosen there), with two changes: the pantograph's base hinge
+the pantograph and the pan-head/wire contact are those of ``models/seo2005_catenary.py``, built
+from the same library pieces (:func:`symcat.catenary.seed.add_seed_catenary` and the scene fragment
+:func:`symcat.pantograph.seo2005.add_seo2005_pantograph`, whose modules list every dimension
+chosen there), with two changes: the pantograph's base hinge
 and its damper and coupling rod attach to the car body's roof, above the vehicle's centre, at
 ``ROOF_HEIGHT_M`` = 3.8 m above the rail top (assumed), and the wire is therefore at 6.3 m (the
 pantograph geometry puts the base 2.5 m below the wire).
@@ -22,35 +24,28 @@ Summary: the keys of ``seo2005_catenary`` plus ``wheel_names``, ``wheel_normal_f
 """
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 
 from symcat.analysis.equilibrium import solve_equilibrium
 from symcat.assembly.multibody import MultibodyModel
+from symcat.catenary.seed import PARAMETERS as CATENARY_PARAMETERS
+from symcat.catenary.seed import add_seed_catenary_from
 from symcat.errors import SolverError
 from symcat.integrate import simulate
 from symcat.model import Model, ModelOutput, Parameter
+from symcat.pantograph.seo2005 import PARAMETERS as PANTOGRAPH_PARAMETERS
+from symcat.pantograph.seo2005 import (B_DEPTH, G, MASSES, add_seo2005_pantograph_from, check_run, contact_history,
+                                       static_contact_force, wire_atol)
 from symcat.scene import Scene
 from symcat.vehicle import VehicleParameters, add_vehicle, wheel_forces
 from symcat.wheelrail import PAIR_NAMES, profile_pair
 
 
-def _catenary_module():
-    spec = importlib.util.spec_from_file_location("_seo2005_catenary", Path(__file__).with_name("seo2005_catenary.py"))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-cat = _catenary_module()
-G = cat.G
 ROOF_HEIGHT_M = 3.8
-WIRE_HEIGHT_M = ROOF_HEIGHT_M + cat.B_DEPTH
-PANTOGRAPH = ("lower_arm", "upper_arm", "plunger", "panhead")
+WIRE_HEIGHT_M = ROOF_HEIGHT_M + B_DEPTH
+PANTOGRAPH = tuple(MASSES)          # lower_arm, upper_arm, plunger, panhead
 
-_CATENARY = {q.name: q for q in cat.PARAMETERS}
+_CATENARY = {**CATENARY_PARAMETERS, **PANTOGRAPH_PARAMETERS}
 PARAMETERS = [
     Parameter("t_end", 1.0, "s", "simulated time", minimum=0.0, exclusive_minimum=True),
     *(_CATENARY[n] for n in ("contact", "element", "n_elements")),
@@ -71,24 +66,31 @@ PARAMETERS = [
 def build(p: dict):
     """Static equilibrium of catenary and pantograph, then the full scene starting from it.
     Returns the full model, the vehicle layout and the equilibrium."""
-    sub = MultibodyModel(cat.build(p, z0=WIRE_HEIGHT_M, carrier_fixed=True))
+    sub = MultibodyModel(_catenary_and_pantograph(p))
     eq = solve_equilibrium(sub)
     scene = Scene(gravity=(0.0, 0.0, -G))
     layout = add_vehicle(scene, profile_pair(p["profile"], 0.05), speed_ms=p["speed"],
                          creep={"nonlinear": "polach"}.get(p["creep"], p["creep"]),
                          friction_coefficient=p["friction_coefficient"], lateral_offset_m=p["lateral_offset_m"],
                          x_m=p["start"], parameters=VehicleParameters(), car_body_load_N=_roof_load_N(sub, eq))
-    cat.add_catenary(scene, p, WIRE_HEIGHT_M)
-    cat.add_pantograph(scene, p, WIRE_HEIGHT_M, base=layout.car_body)
+    add_seed_catenary_from(scene, p, WIRE_HEIGHT_M)
+    add_seo2005_pantograph_from(scene, p, "wire", WIRE_HEIGHT_M, base=layout.car_body)
     model = MultibodyModel(scene)
     _start_from(model, sub, eq)
     return model, layout, eq
 
 
+def _catenary_and_pantograph(p: dict) -> Scene:
+    """The catenary and the pantograph on a fixed carrier (the static start)."""
+    scene = add_seed_catenary_from(Scene(gravity=(0.0, 0.0, -G)), p, WIRE_HEIGHT_M)
+    add_seo2005_pantograph_from(scene, p, "wire", WIRE_HEIGHT_M, carrier_fixed=True)
+    return scene
+
+
 def _roof_load_N(sub, eq) -> float:
     """What the pantograph puts on the roof at equilibrium: its weight plus the wire's push."""
     mass = sum(b.mass for b in sub.scene.rigid_bodies if b.name in PANTOGRAPH)
-    return mass * G + cat.static_contact_force(eq)
+    return mass * G + static_contact_force(eq)
 
 
 def _start_from(model, sub, eq) -> None:
@@ -106,22 +108,22 @@ def _start_from(model, sub, eq) -> None:
 
 
 def run(p: dict) -> ModelOutput:
-    cat.check(p)
+    check_run(p)
     model, layout, eq = build(p)
     off = model.rigid_offset["panhead"]
     n_out = max(10, int(round(p["n_out"] * p["t_end"])))
     try:
-        res = simulate(model, p["t_end"], "augmented", "ggl", rtol=p["rtol"], atol=cat._atol(model, p["rtol"] * 1e-2),
+        res = simulate(model, p["t_end"], "augmented", "ggl", rtol=p["rtol"], atol=wire_atol(model, p["rtol"] * 1e-2),
                        n_out=n_out, progress=p.get("progress", True))
     except SolverError as err:
         raise SolverError(f"{err} (seo2005: vehicle, pantograph and catenary; try a tighter rtol)",
                           partial=err.partial) from err
     z = res.q[:, off + 2] - WIRE_HEIGHT_M
     acc = res.a[:, off + 2]
-    force, lost, s_hist = cat.contact_history(res, p["contact"])
+    force, lost, s_hist = contact_history(res, p["contact"])
     wheels = wheel_forces(res, layout)
     names = layout.contact_names
-    static_force = cat.static_contact_force(eq)
+    static_force = static_contact_force(eq)
     summary = {
         "panhead_z_mean_m": float(z.mean()), "panhead_z_std_m": float(z.std()),
         "contact_force_mean_N": float(force.mean()), "contact_force_std_N": float(force.std()),
