@@ -360,7 +360,7 @@ def run_model(model: str | Model, params: dict | None = None, out: str | Path | 
         except KeyboardInterrupt:
             record_stop(interrupted_outside_integration())
         except SolverError as err:  # before the time integration (statics, form finding)
-            record_stop(EarlyStop(None, None, str(err).strip().splitlines()[0], False))
+            record_stop(EarlyStop(None, None, (err.reason.strip().splitlines() or [type(err).__name__])[0], False))
         except SymcatError:
             paths.discard()
             raise

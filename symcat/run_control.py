@@ -13,7 +13,6 @@ second Ctrl-C, it raises :class:`KeyboardInterrupt` at once.
 """
 from __future__ import annotations
 
-import re
 import signal
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -55,10 +54,6 @@ class Interrupted(SolverError):
     def __init__(self, t_s: float, t_end_s: float):
         super().__init__(f"interrupted at t = {t_s:.6g} s of {t_end_s:.6g} s")
         self.t_s, self.t_end_s = t_s, t_end_s
-
-
-#: The Python API's pointer to the partial result, in failure messages.
-_PARTIAL_HINT = re.compile(r"[;,]?\s*(the results so far are in \.partial|\(\.partial\))")
 
 
 class _State:
@@ -118,8 +113,7 @@ def ended_early(error: SolverError, t_s: float, t_end_s: float) -> bool:
         return False
     if _STATE.stop is None:
         interrupted = isinstance(error, Interrupted)
-        reason = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
-        reason = _PARTIAL_HINT.sub("", reason)  # where the results are is the caller's to say
+        reason = error.reason.strip().splitlines()[0] if error.reason.strip() else type(error).__name__
         _STATE.stop = EarlyStop(t_s, t_end_s, reason, interrupted)
     return True
 

@@ -118,7 +118,7 @@ def solve_static(
                 raise SolverError(
                     f"static solve stopped at load factor {lam:.4g} of 1: {reason}; the load increment fell "
                     f"below min_step={min_step:g}. Try more load_steps, or check supports (a mechanism) and "
-                    "loads; the partial result is in .partial",
+                    "loads",
                     partial,
                 )
     bar.close()

@@ -438,6 +438,6 @@ class ContactStepper:
                 emitted += 1
             reason = lost_contact(self.form, x, z, self.checks)
             if reason is not None:
-                raise SolverError(f"at t = {t_b:.6g} s {reason}; the results so far are in .partial")
+                raise SolverError(f"at t = {t_b:.6g} s {reason}")
         return x, z
 

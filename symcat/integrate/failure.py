@@ -51,7 +51,7 @@ def failure(form, exc, t, x, z, dae_fn, dt, open_flags=()) -> SolverError:
                f"output step ahead: {worst} ({res.max(initial=0):.3g}).")
     message += _dependent_rows(form, x, z, t)
     message += (" Try a smaller rtol or max_step, the other formulation or index, or look for a joint or "
-                "force that becomes singular; the results so far are in .partial")
+                "force that becomes singular")
     return SolverError(message)
 
 

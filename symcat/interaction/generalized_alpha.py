@@ -133,7 +133,7 @@ def _integrate(line, t_end, dt, rho_inf, tol, max_iterations, record_every, prog
                     if result is None:
                         raise SolverError(f"generalized-alpha: Newton did not converge at t={t:.6g} s even with the step "
                                           f"divided by {sub}; look at the contact force and dropper states recorded "
-                                          "up to this time (.partial)", rec)
+                                          "up to this time", rec)
                 acc_prev = acc
                 y, v, acc, a, lam, states, iters = result
                 t = (step + 1) * dt

@@ -63,8 +63,7 @@ from symcat.dae.initial import consistent_state
 from symcat.errors import ParameterError
 from symcat.integrate.shifted import SharedDerivatives, shifted_dae
 from symcat.model import load_model
-from symcat.scene import CreepModel, Driving, PointLoad, RigidBody, Scene, WheelRailJoint
-from symcat.wheelrail import WheelsetDimensions, profile_pair, wheelset_on_track
+from tests.codegen.test_model_dae import _wheelset
 
 EPS = np.finfo(float).eps
 #: The multiple of the estimated difference error an entry may differ by. The estimates are of
@@ -195,20 +194,7 @@ def _pendulum_model():
 def _wheelset_model():
     """A wheelset rolling at 10 m/s, 2 mm off centre, with Polach creep forces: the scene of
     tests/codegen/test_model_dae.py (so its compiled model DAE is the same library)."""
-    pair = profile_pair("s1002_uic60", 0.05)
-    dims = WheelsetDimensions(tape_circle_distance_m=1.5, nominal_radius_m=0.46)
-    placed = wheelset_on_track(pair.wheel, pair.rail, 0.002, wheelset=dims)
-    r_mean = 0.5 * sum(placed.contacts[side].rolling_radius_m for side in ("left", "right"))
-    spin = placed.rotation[:, 1] * 10.0 / r_mean
-    scene = Scene(gravity=(0.0, 0.0, -9.81))
-    scene.add(RigidBody("wheelset", 1813.0, (1120.0, 112.0, 1120.0), position=placed.position_m,
-                        rotation=placed.rotation, velocity=(10.0, 0.0, 0.0), angular_velocity=tuple(spin)))
-    scene.add(PointLoad("axle_load", "wheelset", force=(0.0, 0.0, -100e3)))
-    for side in ("left", "right"):
-        scene.add(WheelRailJoint(f"wr_{side}", "wheelset", side, pair.wheel, pair.rail, wheelset=dims,
-                                 creep=CreepModel("polach", nominal_normal_force_N=59e3)))
-    scene.add(Driving("drive", "wheelset", direction=(1.0, 0.0, 0.0), velocity=10.0))
-    return MultibodyModel(scene)
+    return _wheelset("s1002_uic60", "polach")
 
 
 @functools.cache

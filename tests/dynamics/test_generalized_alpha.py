@@ -15,8 +15,8 @@ from symcat.errors import ParameterError, SolverError
 from symcat.integrate import simulate
 from symcat.integrate.generalized_alpha import generalized_alpha, integrate_alpha
 from symcat.model import model_path
-from symcat.scene import AncfBody, Material, RigidBody, Scene, Section, SlidingJoint
 from tests.dynamics.test_contact import head_under_wire
+from tests.dynamics.test_sliding import ring
 
 G = 9.81
 
@@ -153,23 +153,6 @@ def test_slider_on_a_flexible_wire_matches_idas(slider_case, record_property):
         assert getattr(res, name).shape[0] == ref.t_s.shape[0], name
     assert set(res.energy_J) == {"kinetic", "potential", "total"}
     assert res.stats["steps"] == 200 and res.stats["factorizations"] <= res.stats["newton_iterations"]
-
-
-def ring(n_elements, window, radius=1.0, speed=5.0, mass=0.3):
-    """A bead launched at ``speed`` along a fixed, clamped circular wire of 350 degrees (no gravity)."""
-    phi = np.radians(np.linspace(0.0, 350.0, n_elements + 1))
-    nodes = np.column_stack([radius * np.cos(phi), radius * np.sin(phi), 0 * phi, -np.sin(phi), np.cos(phi), 0 * phi])
-    wire = AncfBody.from_nodes("ring", "cable3d", nodes, radius * (phi[1] - phi[0]), Material(1e9, 1000),
-                               Section.circle(0.01))
-    for k in range(n_elements + 1):
-        wire.clamp(k)
-    scene = Scene()
-    scene.add(wire)
-    phi0 = phi[1] * 0.5
-    scene.add(RigidBody("bead", mass, (1e-4, 1e-4, 1e-4), (radius * np.cos(phi0), radius * np.sin(phi0), 0.0),
-                        velocity=(-speed * np.sin(phi0), speed * np.cos(phi0), 0.0)))
-    scene.add(SlidingJoint("joint", "ring", "bead", s0=radius * phi0, reference_direction=(0, 0, 1)))
-    return MultibodyModel(scene, window=window)
 
 
 def test_element_windows_move_between_steps():
