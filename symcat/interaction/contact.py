@@ -82,3 +82,31 @@ class WireLocator:
         n, _ = hermite(xi)
         index = np.array([self.z_index[k], self.zx_index[k], self.z_index[k + 1], self.zx_index[k + 1]])
         return WirePoint(k, xi, index, n * np.array([1.0, length, 1.0, length]))
+
+
+def contact_wire_locators(structure) -> list[WireLocator]:
+    """A :class:`WireLocator` for the contact wire of each tension section of ``structure``
+    (a :class:`~symcat.catenary.CatenaryStructure`)."""
+    return [WireLocator(structure.cw_xyz[r, 0], structure.cw_xx[r], structure.cw_xyz[r, 2], structure.cw_zx[r],
+                        body.params[:, body.element.param_names.index("length")])
+            for r, body in zip(structure.section_rows, structure.contacts)]
+
+
+def running_wire(structure, locators: list[WireLocator], q: np.ndarray, x: float) -> int:
+    """The tension section whose contact wire is lowest at ``x`` in the state ``q``: the one in
+    running, that a pan-head there touches."""
+    heights = {w: locators[w].locate(q, x).height(q) for w, sec in enumerate(structure.sections) if sec.covers(x)}
+    return min(heights, key=heights.get)
+
+
+def point_loads(n: int, locators: list[WireLocator], wires, xs, forces):
+    """``q -> (f, None)``: upward point forces ``forces`` (N) on the contact wires ``wires`` at
+    ``xs`` (m), as generalized forces on the ``n`` coordinates (the ``extra`` of
+    :func:`~symcat.catenary.coupled_equilibrium`)."""
+    def loads(q):
+        f = np.zeros(n)
+        for x, force, w in zip(xs, forces, wires):
+            point = locators[w].locate(q, x)
+            np.add.at(f, point.index, force * point.weights)
+        return f, None
+    return loads

@@ -19,7 +19,7 @@ import scipy.sparse.linalg as spla
 from ..catenary.formfinding import FormFindingResult, coupled_equilibrium
 from ..errors import ParameterError, SolverError
 from ..pantograph.lumped import LumpedPantograph
-from .contact import WireLocator, WirePoint, hermite
+from .contact import WireLocator, WirePoint, contact_wire_locators, hermite, point_loads, running_wire
 
 CONTACT_MODELS = ("penalty", "bilateral")
 
@@ -96,9 +96,7 @@ class CoupledLine:
         self.panto_slices = [slice(a, b) for a, b in zip(offsets[:-1], offsets[1:])]
         self.head_index = np.array([s.stop - 1 for s in self.panto_slices], dtype=int)
         self.n = int(offsets[-1])
-        self.locators = [WireLocator(st.cw_xyz[r, 0], st.cw_xx[r], st.cw_xyz[r, 2], st.cw_zx[r],
-                                     body.params[:, body.element.param_names.index("length")])
-                         for r, body in zip(st.section_rows, st.contacts)]
+        self.locators = contact_wire_locators(st)
         self.z_ref = np.array([st.running_height(r.x_start) for r in runs])
         self._matrices()
 
@@ -252,14 +250,9 @@ class CoupledLine:
         q0 = self.catenary_q(y)
         wires = [self._running_wire(q0, x) for x in self.x_contact(0.0)]  # fixed: Newton needs a smooth load
 
-        def point_loads(q):  # the contact forces on the running wire, at the pan-heads' positions
-            f = np.zeros(self.structure.n)
-            for x, fc, w in zip(self.x_contact(0.0), load, wires):
-                point = self.locators[w].locate(q, x)
-                np.add.at(f, point.index, fc * point.weights)
-            return f, None
-
-        y[: self.n_cat] = coupled_equilibrium(self.structure, self.catenary_q(y), point_loads)[self.free]
+        # the contact forces on the running wire, at the pan-heads' positions
+        loads = point_loads(self.structure.n, self.locators, wires, self.x_contact(0.0), load)
+        y[: self.n_cat] = coupled_equilibrium(self.structure, self.catenary_q(y), loads)[self.free]
         q = self.catenary_q(y)
         for p, (run, sl) in enumerate(zip(self.runs, self.panto_slices)):
             m, c, k = run.pantograph.matrices()
@@ -273,9 +266,7 @@ class CoupledLine:
 
     def _running_wire(self, q: np.ndarray, x: float) -> int:
         """The section whose contact wire is lowest at ``x`` (the one in running)."""
-        heights = {w: self.locators[w].locate(q, x).height(q) for w, sec in enumerate(self.structure.sections)
-                   if sec.covers(x)}
-        return min(heights, key=heights.get)
+        return running_wire(self.structure, self.locators, q, x)
 
     def static_state(self, rtol: float = 1e-9, max_iterations: int = 40,
                      z_ref: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:

@@ -122,25 +122,15 @@ def loaded_wire_height(form, x: float, force: float, section: int | None = None)
     pressed up by ``force`` (N) at ``x``: what ``CoupledLine._place_pantographs`` solves (the
     structure's static equilibrium under the point load, by ``coupled_equilibrium``)."""
     from ..catenary.formfinding import coupled_equilibrium
-    from ..interaction.contact import WireLocator
+    from ..interaction.contact import contact_wire_locators, point_loads, running_wire
 
     st = form.structure
-    locators = [WireLocator(st.cw_xyz[r, 0], st.cw_xx[r], st.cw_xyz[r, 2], st.cw_zx[r],
-                            body.params[:, body.element.param_names.index("length")])
-                for r, body in zip(st.section_rows, st.contacts)]
-    covering = [w for w, sec in enumerate(st.sections) if sec.covers(x)]
-    if not covering:
+    locators = contact_wire_locators(st)
+    if not any(sec.covers(x) for sec in st.sections):
         raise ParameterError(f"x={x:g} m: no contact wire there")
-    if section is None:  # the wire in running: lowest at x (as CoupledLine._running_wire)
-        section = min(covering, key=lambda w: locators[w].locate(form.q, x).height(form.q))
-
-    def point_loads(q):
-        f = np.zeros(st.n)
-        point = locators[section].locate(q, x)
-        np.add.at(f, point.index, force * point.weights)
-        return f, None
-
-    q = coupled_equilibrium(st, form.q.copy(), point_loads)
+    if section is None:  # the wire in running: lowest at x
+        section = running_wire(st, locators, form.q, x)
+    q = coupled_equilibrium(st, form.q.copy(), point_loads(st.n, locators, [section], [x], [force]))
     return locators[section].locate(q, x).height(q)
 
 
