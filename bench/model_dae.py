@@ -22,8 +22,8 @@ from symcat.codegen.model_dae import FLAGS, model_library, write_dae_c
 from symcat.codegen.optimized import OPTIMIZE_ENV, OPTIMIZED_FLAGS
 from symcat.dae.formulation import Formulation
 from symcat.dae.initial import consistent_state
-from symcat.integrate import simulate
 from symcat.scene import Scene
+from symcat.simulation import simulate
 from symcat.vehicle import add_vehicle
 from symcat.wheelrail import profile_pair
 

@@ -7,9 +7,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from symcat.assembly.multibody import MultibodyModel
-from symcat.integrate.choice import integrate_model, integrator_parameters
+from symcat.integrate import IdasSettings
 from symcat.model import Model, ModelOutput, Parameter
 from symcat.scene import Revolute, RigidBody, Scene
+from symcat.simulation import integrate_model, integrator_parameters
 
 G = 9.81
 _POS = dict(minimum=0.0, exclusive_minimum=True)
@@ -75,8 +76,8 @@ def run(p: dict) -> ModelOutput:
     if p["t_end"] == 0:
         tip = np.array(scene.rigid_bodies[1].position) + 0.5 * p["length"] * scene.rigid_bodies[1].rotation[:, 0]
         return ModelOutput({"tip_position_m": tip.tolist(), "energy_drift_rel": 0.0, "simulated_s": 0.0})
-    res = integrate_model(model, p, p["t_end"], p["formulation"], p["index"], n_out=100, rtol=p["rtol"],
-                          atol=p["rtol"] * 1e-2)
+    settings = IdasSettings(rtol=p["rtol"], atol=p["rtol"] * 1e-2, n_out=100)
+    res = integrate_model(model, p, p["t_end"], p["formulation"], p["index"], settings)
     from symcat.scene.rigid import rotation_matrix
 
     off = model.rigid_offset["rod2"]

@@ -31,12 +31,13 @@ from symcat.assembly.multibody import MultibodyModel
 from symcat.catenary.seed import PARAMETERS as CATENARY_PARAMETERS
 from symcat.catenary.seed import add_seed_catenary_from
 from symcat.errors import SolverError
-from symcat.integrate import simulate
+from symcat.integrate import IdasSettings
 from symcat.model import Model, ModelOutput, Parameter
 from symcat.pantograph.seo2005 import PARAMETERS as PANTOGRAPH_PARAMETERS
 from symcat.pantograph.seo2005 import (B_DEPTH, G, MASSES, add_seo2005_pantograph_from, check_run, contact_history,
                                        static_contact_force, wire_atol)
 from symcat.scene import Scene
+from symcat.simulation import simulate
 from symcat.vehicle import VehicleParameters, add_vehicle, wheel_forces
 from symcat.wheelrail import PAIR_NAMES, profile_pair
 
@@ -113,8 +114,9 @@ def run(p: dict) -> ModelOutput:
     off = model.rigid_offset["panhead"]
     n_out = max(10, int(round(p["n_out"] * p["t_end"])))
     try:
-        res = simulate(model, p["t_end"], "augmented", "ggl", rtol=p["rtol"], atol=wire_atol(model, p["rtol"] * 1e-2),
-                       n_out=n_out, progress=p.get("progress", True))
+        settings = IdasSettings(rtol=p["rtol"], atol=wire_atol(model, p["rtol"] * 1e-2), n_out=n_out,
+                                progress=p.get("progress", True))
+        res = simulate(model, p["t_end"], "augmented", "ggl", settings)
     except SolverError as err:
         raise SolverError(f"{err} (seo2005: vehicle, pantograph and catenary; try a tighter rtol)",
                           partial=err.partial) from err

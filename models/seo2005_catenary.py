@@ -42,12 +42,13 @@ from symcat.analysis.equilibrium import solve_equilibrium
 from symcat.assembly.multibody import MultibodyModel
 from symcat.catenary.seed import PARAMETERS as CATENARY_PARAMETERS
 from symcat.catenary.seed import add_seed_catenary_from
-from symcat.integrate.choice import integrate_model, integrator_parameters
+from symcat.integrate import IdasSettings
 from symcat.model import Model, ModelOutput, Parameter
 from symcat.pantograph.seo2005 import PARAMETERS as PANTOGRAPH_PARAMETERS
 from symcat.pantograph.seo2005 import (G, add_seo2005_pantograph_from, check_run, contact_history,
                                        static_contact_force, wire_atol)
 from symcat.scene import Scene
+from symcat.simulation import integrate_model, integrator_parameters
 
 _SHARED = {**CATENARY_PARAMETERS, **PANTOGRAPH_PARAMETERS}
 
@@ -99,8 +100,8 @@ def run(p: dict) -> ModelOutput:
     # IDAS: index 1 (Baumgarte); generalized-alpha: the stabilized index-2 form (positions and
     # velocities enforced).
     index = "ggl" if p["integrator"] == "generalized_alpha" else "1"
-    res = integrate_model(model, p, p["t_end"], p["formulation"], index, n_out=n_out, rtol=p["rtol"],
-                          atol=wire_atol(model, p["rtol"] * 1e-2))
+    settings = IdasSettings(rtol=p["rtol"], atol=wire_atol(model, p["rtol"] * 1e-2), n_out=n_out)
+    res = integrate_model(model, p, p["t_end"], p["formulation"], index, settings)
     z = res.q[:, off + 2]
     acc = res.a[:, off + 2]
     force, lost, s_hist = contact_history(res, p["contact"])

@@ -9,9 +9,10 @@ from __future__ import annotations
 import numpy as np
 
 from symcat.assembly.multibody import MultibodyModel
-from symcat.integrate.choice import integrate_model, integrator_parameters
+from symcat.integrate import IdasSettings
 from symcat.model import Model, ModelOutput, Parameter
 from symcat.scene import AncfBody, Material, RigidBody, Scene, Section, SlidingJoint
+from symcat.simulation import integrate_model, integrator_parameters
 
 _POS = dict(minimum=0.0, exclusive_minimum=True)
 
@@ -64,8 +65,9 @@ def run(p: dict) -> ModelOutput:
     if p["t_end"] == 0:
         return ModelOutput({"s_final_m": p["s0"], "body_position_m": list(scene.rigid_bodies[0].position),
                             "max_position_drift_m": 0.0, "simulated_s": 0.0, "steps": 0})
-    res = integrate_model(model, p, p["t_end"], p["formulation"], p["index"], n_out=max(20, int(200 * p["t_end"])),
-                          rtol=p["rtol"], atol=p["rtol"] * 1e-2, cholesky=p["cholesky"])
+    settings = IdasSettings(rtol=p["rtol"], atol=p["rtol"] * 1e-2, cholesky=p["cholesky"],
+                            n_out=max(20, int(200 * p["t_end"])))
+    res = integrate_model(model, p, p["t_end"], p["formulation"], p["index"], settings)
     off = model.rigid_offset["body"]
     summary = {
         "s_final_m": float(res.s_m[-1, 0]),

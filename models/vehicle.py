@@ -68,10 +68,11 @@ import numpy as np
 
 from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError, SolverError
-from symcat.integrate import simulate
-from symcat.integrate.simulate import VELOCITY_ATOL_FACTOR
+from symcat.integrate import IdasSettings
+from symcat.integrate.settings import VELOCITY_ATOL_FACTOR
 from symcat.model import Model, ModelOutput, Parameter, existing_file
 from symcat.scene import Scene
+from symcat.simulation import simulate
 from symcat.vehicle import (DRIVES, VehicleParameters, add_vehicle, curve_track, lateral_displacement_m,
                             lateral_force_sum_N, momentum_rate_N, steady_curving_forces_N, wheel_forces)
 from symcat.wheelrail import PAIR_NAMES, profile_pair
@@ -211,9 +212,10 @@ def run(p: dict) -> ModelOutput:
     _, layout, model = build(p)
     try:
         atol = p.get("atol") or 0.1 * p["rtol"]
-        res = simulate(model, p["t_end"], index=p["index"], rtol=p["rtol"], atol=atol,
-                       velocity_atol=p.get("atol_velocity") or VELOCITY_ATOL_FACTOR * atol, n_out=int(p["n_out"]),
-                       progress=p.get("progress", True))
+        settings = IdasSettings(rtol=p["rtol"], atol=atol,
+                                velocity_atol=p.get("atol_velocity") or VELOCITY_ATOL_FACTOR * atol,
+                                n_out=int(p["n_out"]), progress=p.get("progress", True))
+        res = simulate(model, p["t_end"], index=p["index"], settings=settings)
     except SolverError as err:
         hint = ("; cant_ramp=smooth (the ends of a linear cant ramp are kinks of the rails, impacts the rigid "
                 "contacts do not get past)") if p.get("cant_m", 0.0) > 0 and p.get("cant_ramp") == "linear" else ""

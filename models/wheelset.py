@@ -33,11 +33,11 @@ Summary
     At the static offset (t = 0): normal forces from the multipliers and ``r_left - r_right``.
 ``normal_force_min_N``
     Smallest normal force of either wheel over the run (0 while a wheel is lifted: the rail-frame
-    contacts open and land again, :mod:`symcat.integrate.contact_switching`; a wheel running off
+    contacts open and land again, :mod:`symcat.wheelrail_events.contact_switching`; a wheel running off
     its rail ends the run with an error).
 
 The contact point of each wheel jumps where another point of the profiles comes lower (see
-:mod:`symcat.integrate.contact_jumps`; ``contact_jumps`` in the statistics).
+:mod:`symcat.wheelrail_events.contact_jumps`; ``contact_jumps`` in the statistics).
 """
 from __future__ import annotations
 
@@ -47,11 +47,13 @@ import numpy as np
 
 from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError, SolverError
-from symcat.integrate import simulate
-from symcat.integrate.simulate import VELOCITY_ATOL_FACTOR
+from symcat.integrate import IdasSettings
+from symcat.integrate.settings import VELOCITY_ATOL_FACTOR
 from symcat.model import Model, ModelOutput, Parameter, existing_file
 from symcat.scene import CreepModel, Driving, PointLoad, RigidBody, Scene, WheelRailJoint
-from symcat.wheelrail import PAIR_NAMES, WheelsetDimensions, profile_pair, wheelset_on_track
+from symcat.simulation import simulate
+from symcat.vehicle import wheelset_on_track
+from symcat.wheelrail import PAIR_NAMES, WheelsetDimensions, profile_pair
 from symcat.wheelrail.track import Tangent, TrackLayout, rail_offset_for, read_irregularities
 
 G = 9.81
@@ -161,9 +163,10 @@ def run(p: dict) -> ModelOutput:
     scene, model, placed, pair = build(p)
     try:
         atol = p.get("atol") or 0.01 * p["rtol"]
-        res = simulate(model, p["t_end"], formulation=p["formulation"], rtol=p["rtol"], atol=atol,
-                       velocity_atol=p.get("atol_velocity") or VELOCITY_ATOL_FACTOR * atol, n_out=int(p["n_out"]),
-                       progress=p.get("progress", True))
+        settings = IdasSettings(rtol=p["rtol"], atol=atol,
+                                velocity_atol=p.get("atol_velocity") or VELOCITY_ATOL_FACTOR * atol,
+                                n_out=int(p["n_out"]), progress=p.get("progress", True))
+        res = simulate(model, p["t_end"], formulation=p["formulation"], settings=settings)
     except SolverError as err:
         raise SolverError(f"{err} (wheelset model: one constraint contact point per wheel, which jumps to the "
                           "lowest point of the gap; a free wheelset hunts, and at speed its flanges strike)",

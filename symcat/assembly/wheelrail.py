@@ -123,7 +123,7 @@ def add_wheelrail(model, joint: WheelRailJoint) -> WheelRailEntry:
         raise ParameterError(
             f"wheel/rail contact {joint.name!r}: the {joint.side} wheel of {body.name!r} is {point.gap_m * 1e3:.2f} mm "
             f"{'above' if point.gap_m > 0 else 'into'} its rail at the initial position (allowed "
-            f"{PLACEMENT_TOLERANCE_M * 1e3:g} mm); place the wheelset with symcat.wheelrail.wheelset_on_track")
+            f"{PLACEMENT_TOLERANCE_M * 1e3:g} mm); place the wheelset with symcat.vehicle.wheelset_on_track")
     s0 = point.s
     head = contact.parameters(s0)[:6]
     entry = WheelRailEntry(joint, contact, contact.library, body, rows, s0, head,

@@ -3,16 +3,13 @@ step and order, error-controlled) or the generalized-alpha method (fixed step, n
 dissipation of what the step does not resolve: the undamped axial waves of ANCF wires, on
 which IDAS takes tens of thousands of steps per simulated second).
 
-Models declare :func:`integrator_parameters` and call :func:`integrate_model`: one place that
-knows which integrator, formulation and index combinations run.
+Models declare :func:`integrator_parameters` and call :func:`symcat.simulation.integrate_model`
+(above this layer: it attaches the event handlers a model needs): one place that knows which
+integrator, formulation and index combinations run.
 """
 from __future__ import annotations
 
-from ..errors import ParameterError
 from ..model import Parameter
-from .generalized_alpha import generalized_alpha
-from .results import SimulationResult
-from .simulate import simulate
 
 INTEGRATORS = ("idas", "generalized_alpha")
 #: The model's ``index`` under generalized-alpha: the constraint levels enforced.
@@ -29,42 +26,3 @@ def integrator_parameters(dt_s: float = 1e-3, rho_inf: float = 0.9) -> list[Para
         Parameter("rho_inf", rho_inf, "-", "spectral radius at infinite frequency of generalized_alpha (1: no "
                   "numerical dissipation)", minimum=0.0, maximum=1.0),
     ]
-
-
-def integrate_model(model, p: dict, t_end: float, formulation: str, index: str, n_out: int = 200,
-                    progress: bool = True, **idas_options) -> SimulationResult:
-    """Integrate ``model`` with the integrator that ``p`` (the model's parameters) chooses.
-
-    Parameters
-    ----------
-    model : MultibodyModel
-    p : dict
-        Holds ``integrator``, ``dt`` (s) and ``rho_inf`` (:func:`integrator_parameters`).
-    t_end : float
-        Simulated time (s).
-    formulation, index : str
-        As for :func:`~symcat.integrate.simulate`; under generalized-alpha the augmented form
-        only, ``index`` choosing the constraint levels (:data:`ALPHA_VARIANTS`).
-    n_out : int
-        Output intervals.
-    **idas_options
-        Passed to :func:`~symcat.integrate.simulate` (``rtol``, ``atol``, ...); unused by
-        generalized-alpha.
-
-    Raises
-    ------
-    ParameterError
-        A combination that cannot run (generalized-alpha with the embedded form, or with
-        wheel/rail contacts), naming it and what is allowed.
-    """
-    if p["integrator"] == "idas":
-        return simulate(model, t_end, formulation, index, n_out=n_out, progress=progress, **idas_options)
-    if formulation != "augmented":
-        raise ParameterError(f"formulation={formulation} with integrator=generalized_alpha: generalized-alpha "
-                             "integrates the augmented form; use formulation=augmented, or integrator=idas")
-    contacts = [e.joint.name for e in model.wheelrail]
-    if contacts:
-        raise ParameterError(f"integrator=generalized_alpha: not yet with wheel/rail contacts "
-                             f"({', '.join(contacts)}); use integrator=idas")
-    return generalized_alpha(model, t_end, p["dt"], p["rho_inf"], variant=ALPHA_VARIANTS[str(index)], n_out=n_out,
-                             progress=progress)

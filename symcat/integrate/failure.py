@@ -1,5 +1,6 @@
-"""Failure reports of the IDAS driver: the time, IDAS's reason, the worst residual by name and
-nearly dependent constraint rows."""
+"""Failure reports of the IDAS driver (the time, IDAS's reason, the worst residual by name and
+nearly dependent constraint rows) and the state's blocks by name, which they and the event
+handlers read."""
 from __future__ import annotations
 
 import casadi as ca
@@ -7,12 +8,10 @@ import numpy as np
 
 from ..errors import SolverError
 
-#: A failure while a contact point moves faster than this along its wheel profile (m/s) is
-#: reported with it (:func:`sweep_hint`).
-SWEEP_HINT_M_S = 5.0
-
 
 def split_state(form, x, z) -> dict:
+    """The state ``(x, z)`` by block name (:meth:`symcat.dae.Formulation.blocks`: ``q``, ``v``,
+    ``s``, ``lambda``, ...)."""
     xb, zb = form.blocks()
     out = {k: np.asarray(x)[b.slice] for k, b in xb.items()}
     out.update({k: np.asarray(z)[b.slice] for k, b in zb.items() if k not in out})
@@ -71,29 +70,3 @@ def _dependent_rows(form, x, z, t) -> str:
     weights = np.abs(u[:, -1])
     rows = [model.row_names[r] for r in np.argsort(weights)[::-1][:3] if weights[r] > 0.1]
     return f" The constraints are nearly dependent (a locked or singular mechanism?): {', '.join(rows)}."
-
-
-def stall_reason(checks, exc, failures: int, span_s: float) -> str:
-    """Why the contact driver stalled (``failures`` calls failed within ``span_s`` seconds, the
-    last with ``exc``), from its contact checks: the flattest contact."""
-    flat = min(checks, key=lambda c: c.curvature_per_m)
-    last = str(exc).strip().splitlines()[-1] if str(exc).strip() else repr(exc)
-    return (f"{failures} integrator calls failed within {span_s:g} s of simulated time "
-            f"(last: {last.strip('. ')}); the flattest contact is {flat.name}, relative curvature "
-            f"{flat.curvature_per_m:.3g} 1/m with {len(flat.rivals)} other minima of the gap: nearly "
-            "conformal wheel and rail, where one constraint point per wheel is ill-conditioned (another "
-            "n_out or rtol moves the call boundaries; profiles with more curvature difference avoid it)")
-
-
-def sweep_hint(checks) -> str:
-    """Why the contact points may defeat IDAS, if one sweeps: the fastest along its wheel
-    profile when that exceeds :data:`SWEEP_HINT_M_S` (its rate grows as the relative
-    curvature shrinks: nearly conformal profiles, e.g. the flange root of S1002 on the
-    gauge corner of UIC60, crossed without creep damping)."""
-    fast = max(checks, key=lambda c: abs(c.s_rate[0]))
-    rate = abs(float(fast.s_rate[0]))
-    if rate < SWEEP_HINT_M_S:
-        return ""
-    return (f" (the {fast.name} contact point was sweeping along its wheel at {rate:.3g} m/s, relative curvature "
-            f"{fast.curvature_per_m:.3g} 1/m: nearly conformal wheel and rail, which one constraint point per "
-            "wheel follows only as fast as IDAS converges; creep forces damp such sweeps)")

@@ -56,8 +56,8 @@ class SimulationResult:
         ``s`` (n_t, 4: s1w m, s2w rad, s1r m, s2r m), ``xi_x``, ``xi_y`` (-), ``phi_per_m``
         (spin, 1/m), the creep forces ``fx_N``, ``fy_N``, ``mz_Nm`` (zero without creep), the
         normal gap ``gap_m`` (> 0 separated; the constraint drift while in contact), ``open``
-        (bool: lifted off, see :mod:`.contact_switching`) and the times (s) of its lift-offs and
-        touchdowns, ``lift_off_s`` and ``touchdown_s``.
+        (bool: lifted off, see :mod:`symcat.wheelrail_events.contact_switching`) and the times
+        (s) of its lift-offs and touchdowns, ``lift_off_s`` and ``touchdown_s``.
     """
 
     t_s: np.ndarray

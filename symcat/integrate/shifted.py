@@ -1,4 +1,4 @@
-"""The contact driver's integrators (see :mod:`.contact_stepping`): the DAE in the state's scaled
+"""The event stepping driver's integrators (see :mod:`.event_stepping`): the DAE in the state's scaled
 departure from its linear extrapolation over a call, consistent at zero for every start, and the
 cache of integrators built on it."""
 from __future__ import annotations
@@ -120,7 +120,7 @@ MAX_INTEGRATORS = 64
 
 
 class CallIntegrators:
-    """IDAS integrators of one DAE for the contact driver's calls, built on first use over one
+    """IDAS integrators of one DAE for the event stepping driver's calls, built on first use over one
     :class:`SharedDerivatives` per DAE variant (about 2 ms each for the compiled seed vehicle,
     mostly the linear solver's set-up; 9 ms when each derived the DAE's Jacobian anew) and kept,
     the oldest dropped beyond :data:`MAX_INTEGRATORS`.

@@ -1,11 +1,19 @@
 """Integrate a multibody model with CasADi's IDAS.
 
 The run is split into chunks of output points (progress, window moves of sliding joints);
-each chunk continues from the previous state (wheel/rail models: shorter calls with contact
-checks between them, :mod:`.contact_stepping`). Accelerations and multipliers are algebraic and
-kept out of the error test (``suppress_algebraic``): on stiff ANCF models this cuts the step
-count by two orders of magnitude. A failure raises :class:`SolverError` with the time, IDAS's
-reason, the largest residual by name and the result up to the last completed chunk.
+each chunk continues from the previous state. Models with events between integrator calls
+(wheel/rail contact jumps, lift-off and touchdown) run shorter calls with the events checked
+between them: :mod:`.event_stepping`, the events decided by plug-in handlers
+(:class:`.events.EventHandler`, ``handlers=``). This layer knows no wheel/rail contact: a model
+with wheel/rail contacts and no handlers is refused, naming the function that attaches its
+default handlers (:func:`symcat.simulation.simulate`), rather than run without contact jumps.
+Accelerations and multipliers are algebraic and kept out of the error test
+(``suppress_algebraic``): on stiff ANCF models this cuts the step count by two orders of
+magnitude. A failure raises :class:`SolverError` with the time, IDAS's reason, the largest
+residual by name and the result up to the last completed chunk.
+
+The tuning is one :class:`.settings.IdasSettings`; the old keywords (``rtol=``, ``n_out=``,
+...) still build it.
 """
 from __future__ import annotations
 
@@ -24,30 +32,24 @@ from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
 from ..run_control import check_interrupt, ended_early, integrating
-from .contact_switching import initial_open
-from .contact_stepping import CallFailed, ContactStepper
+from .event_stepping import CallFailed, EventStepper
+from .events import EventHandler
 from .failure import failure, split_state
 from .results import SimulationResult, collect_result
+from .settings import VELOCITY_ATOL_FACTOR, IdasSettings, settings_from
 
 log = logging.getLogger(__name__)
 
-#: Simulated time (s) one contact stepper span covers (many output intervals if they are short).
+#: Simulated time (s) one event stepper span covers (many output intervals if they are short).
 CONTACT_GROUP_S = 0.1
 
 STAT_KEYS = ("nsteps", "nfevals", "nlinsetups", "netfails", "nniters", "nncfails")
 
-#: The models' default velocity tolerance (m/s, rad/s) as a multiple of their position tolerance
-#: (m, rad): positions accurate to atol over motions up to 10 rad/s (``simulate``'s own default
-#: is ``atol`` itself).
-VELOCITY_ATOL_FACTOR = 10.0
+__all__ = ["CONTACT_GROUP_S", "STAT_KEYS", "VELOCITY_ATOL_FACTOR", "IdasSettings", "simulate", "update_windows"]
 
 
 def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented", index: str = "1",
-             rtol: float = 1e-6, atol: float = 1e-8, n_out: int = 200, baumgarte: float = 10.0,
-             chunks: int | None = None, max_step: float | None = None, progress: bool = True,
-             algebraic_atol: float = 1e-3, max_steps: int = 500000, cholesky: bool = False,
-             linear_solver: str | None = None, compiled: bool | None = None,
-             velocity_atol=None) -> SimulationResult:
+             settings: IdasSettings | None = None, *, handlers=None, **legacy) -> SimulationResult:
     """Simulate ``model`` from 0 to ``t_end`` seconds.
 
     Parameters
@@ -57,60 +59,44 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
         Simulated time (s), > 0.
     formulation, index : str
         ``augmented``/``embedded`` and ``1``/``ggl`` (see :mod:`symcat.dae.formulation`).
-    rtol, atol : float
-        IDAS tolerances (differential states only). ``atol`` may also be an array over all
-        generalized coordinates (``model.coordinate_names()``), used for the coordinates and
-        their velocities (e.g. looser on the stiff cross-section gradients of a thin beam).
-    velocity_atol : float or array, optional
-        Absolute tolerance of the velocities (m/s, rad/s), a number or an array like ``atol``;
-        default ``atol``. Positions accurate to ``atol`` over a motion of angular frequency
-        ``omega`` need velocities accurate only to ``omega * atol``: on the seed vehicle,
-        ``10 * atol`` takes a quarter to a half fewer steps and removes the error-test failures
-        of its stiff creep modes at rtol 1e-5 (see ``models/vehicle.py``).
-    n_out : int
-        Output intervals.
-    baumgarte : float
-        Stabilization (1/s) of the index-1 forms.
-    chunks : int, optional
-        Integrator calls the run is split into (default: adaptive, about 10, shorter while a
-        sliding point would otherwise leave its element window).
-    max_step : float, optional
-        Largest IDAS step (s).
-    algebraic_atol : float
-        Absolute tolerance of the algebraic variables in IDAS's Newton test (they are not
-        error-controlled).
-    max_steps : int
-        IDAS steps allowed per chunk (wheel/rail models: per call, at most
-        :data:`~symcat.integrate.contact_stepping.MAX_CALL_STEPS`).
-    cholesky : bool
-        Cholesky coordinates for the ANCF bodies (see :class:`symcat.dae.Formulation`).
-    linear_solver : str
-        CasADi linear solver plugin for IDAS's Newton systems: ``csparse`` (sparse LU, 1.6x
-        faster than CasADi's default ``qr`` on a 32-element wire, see the benchmark), ``qr``
-        (sparse QR) or ``lapacklu`` (dense LU). Default: ``csparse`` at index 1, ``qr`` for GGL,
-        whose ill-conditioned index-2 matrices make the LU's pivoting fail (IDA_LSETUP_FAIL).
-    compiled : bool, optional
-        Compile the whole DAE residual and its Jacobian to C for this model
-        (:mod:`symcat.codegen.model_dae`; about 10 s for the seed vehicle the first time, then
-        cached), instead of evaluating CasADi's graph over the kernels. Default: for wheel/rail
-        models in the augmented form without element windows (those rebuild their DAE as the
-        windows move; the embedded form's linear solve does not expand, and a request for it
-        falls back to the graph with a warning).
+    settings : IdasSettings, optional
+        Tolerances, solver and output (default :class:`~.settings.IdasSettings`).
+    handlers : sequence of EventHandler, optional
+        Events between integrator calls (:mod:`.events`; one handler for now): the run then
+        goes in short calls with the events checked between them (:mod:`.event_stepping`).
+        Required for a model with wheel/rail contacts (:func:`symcat.simulation.simulate`
+        attaches them).
+    **legacy
+        The fields of :class:`~.settings.IdasSettings` as keywords (``rtol=1e-8``, ...),
+        replacing those of ``settings``.
+
+    Raises
+    ------
+    ParameterError
+        A bad time, setting or keyword (naming it), or a model with wheel/rail contacts and no
+        handlers.
+    SolverError
+        IDAS failed; ``partial`` holds the result up to the last completed chunk.
     """
+    settings = settings_from(settings, **legacy)
     if not t_end > 0:
         raise ParameterError(f"t_end={t_end}: must be > 0 s")
-    if not 0 < rtol < 1:
-        raise ParameterError(f"rtol={rtol}: must be in (0, 1)")
+    handler = _one_handler(model, handlers)
+    rtol, n_out, chunks, max_step = settings.rtol, settings.n_out, settings.chunks, settings.max_step
     wall0 = time.perf_counter()
-    form = Formulation(model, formulation, index, baumgarte, cholesky)
-    abstol_x = _atol_vector(form, atol, velocity_atol)  # checked before any work
+    form = Formulation(model, formulation, index, settings.baumgarte, settings.cholesky)
+    abstol_x = _atol_vector(form, settings.atol, settings.velocity_atol)  # checked before any work
+    compiled, linear_solver = settings.compiled, settings.linear_solver
     if compiled is None:
         # The embedded form's linear solve (an MX node) does not expand to SX.
         compiled = bool(model.wheelrail) and not model.windowed() and formulation == "augmented"
     if linear_solver is None:
         linear_solver = "csparse" if form.index == "1" else "qr"
-    open_flags = initial_open(form) if model.wheelrail else np.zeros(0)
-    x, z = consistent_state(form, 0.0, open_rows=form.open_rows(open_flags))
+    stats = dict.fromkeys(STAT_KEYS, 0)
+    stats["restarts"] = 0
+    if handler is not None:
+        handler.attach(form, stats)
+    x, z = consistent_state(form, 0.0, open_rows=handler.open_rows() if handler is not None else [])
     t_grid = np.linspace(0.0, t_end, n_out + 1)
     fixed_edges = None
     if chunks:
@@ -119,17 +105,16 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     # absolute tolerance still weighs IDAS's Newton convergence test: with the differential
     # atol, GGL's mu (identically ~0) can never "converge" and IDAS reports IDA_CONV_FAIL.
     n_z = len(z)
-    opts = {"reltol": rtol, "abstolv": abstol_x + [algebraic_atol] * n_z, "suppress_algebraic": True,
-            "calc_ic": False, "max_num_steps": int(max_steps), "linear_solver": linear_solver}
+    opts = {"reltol": rtol, "abstolv": abstol_x + [settings.algebraic_atol] * n_z, "suppress_algebraic": True,
+            "calc_ic": False, "max_num_steps": int(settings.max_steps), "linear_solver": linear_solver}
     if max_step:
         opts["max_step_size"] = max_step
     xs, zs = [x], [z]
     walls = [time.perf_counter() - wall0]  # when each output was known (s)
-    opens = [open_flags.copy()]  # wheel/rail contacts lifted off, at each output
-    events = []                  # their lift-offs and touchdowns (contact_switching.Switch)
-    stats = dict.fromkeys(STAT_KEYS, 0)
-    stats["restarts"] = 0
-    bar = Progress("simulate", t_end, "s", enabled=progress)
+    # The handler's mode (wheel/rail: contacts lifted off) at each output, and its events.
+    modes = [handler.mode().copy() if handler is not None else np.zeros(0)]
+    events = handler.events if handler is not None else []
+    bar = Progress("simulate", t_end, "s", enabled=settings.progress)
     dae_fn = None
     done = 0
 
@@ -165,14 +150,13 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
 
     try:
         with integrating():
-            if model.wheelrail:
-                # Short calls with contact checks between them (see contact_stepping).
+            if handler is not None:
+                # Short calls with the handler's events checked between them (see event_stepping).
                 dae_fn = dae_function()
-                stepper = ContactStepper(form, dae_fn, opts, x, z, stats, STAT_KEYS, open_flags)
-                events = stepper.switching.events
+                stepper = EventStepper(form, dae_fn, opts, x, z, stats, STAT_KEYS, handler)
                 # Output intervals grouped into spans of about CONTACT_GROUP_S (one per interval
                 # where element windows can move, moved between intervals): the stepper's calls cross output
-                # times, so dense output costs neither contact checks nor IDAS restarts.
+                # times, so dense output costs neither event checks nor IDAS restarts.
                 group = 1 if model.windows_move() else max(1, int(CONTACT_GROUP_S / (t_grid[1] - t_grid[0]) + 1e-9))
 
                 def emit(j, x_j, z_j):
@@ -180,7 +164,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
                     xs.append(x_j)
                     walls.append(time.perf_counter() - wall0)
                     zs.append(z_j)
-                    opens.append(stepper.switching.open.copy())
+                    modes.append(handler.mode().copy())
                     done = a + j + 1
                     bar.update(t_grid[done])
 
@@ -194,10 +178,10 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
                         x, z = stepper.advance(x, z, t_grid[a], t_grid[a + 1 : b + 1], emit)
                     except CallFailed as exc:
                         raise failure(form, exc.error, exc.t, exc.x, exc.z, stepper.dae_fn, t_grid[1] - t_grid[0],
-                                      stepper.switching.open) from None
+                                      handler.mode()) from None
                     a = b
                     check_interrupt(t_grid[a], t_end)
-            a, limit = (n_out if model.wheelrail else 0), None
+            a, limit = (n_out if handler is not None else 0), None
             while a < n_out:
                 b = _chunk_end(model, form, x, z, a, n_out, t_grid, fixed_edges)
                 if limit is not None:
@@ -232,12 +216,28 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
                 check_interrupt(t_grid[b], t_end)
     except SolverError as err:
         bar.close()
-        err.partial = collect_result(form, t_grid[: done + 1], xs, zs, stats, wall0, opens, events, walls)
+        err.partial = collect_result(form, t_grid[: done + 1], xs, zs, stats, wall0, modes, events, walls)
         if ended_early(err, t_grid[done], t_end):
             return err.partial
         raise
     bar.close()
-    return collect_result(form, t_grid, xs, zs, stats, wall0, opens, events, walls)
+    return collect_result(form, t_grid, xs, zs, stats, wall0, modes, events, walls)
+
+
+def _one_handler(model, handlers) -> EventHandler | None:
+    """The run's event handler, checked: one or none, and one for a model with wheel/rail
+    contacts (whose DAE takes their open flags as parameters)."""
+    handlers = list(handlers or [])
+    for h in handlers:
+        if not isinstance(h, EventHandler):
+            raise ParameterError(f"handlers: {h!r} is not an EventHandler (symcat.integrate.events)")
+    if len(handlers) > 1:
+        raise ParameterError(f"handlers: {len(handlers)} given; one event handler per run for now")
+    if model.wheelrail and not handlers:
+        names = ", ".join(e.joint.name for e in model.wheelrail)
+        raise ParameterError(f"the model has wheel/rail contacts ({names}), which need their contact-event handlers: "
+                             "use symcat.simulation.simulate (or integrate_model), which attaches them")
+    return handlers[0] if handlers else None
 
 
 def _atol_vector(form, atol, velocity_atol=None) -> list:
@@ -315,6 +315,8 @@ def _window_s(form, x, z) -> np.ndarray:
 
 
 def update_windows(model, form, x, z) -> bool:
+    """Move the element windows of the sliding points that near their edges; True if one moved
+    (the DAE is then rebuilt)."""
     if not model.windowed():
         return False
     s = _window_s(form, x, z)

@@ -72,7 +72,7 @@ class WheelRailJoint:
     with ``y`` toward the left rail and ``z`` up, the rail tops at ``z = 0``; curved track
     (``track`` a :class:`symcat.wheelrail.track.TrackLayout`) follows the layout, ``s1r`` being
     its chainage (see :mod:`symcat.wheelrail.constraint_contact`; place the wheelset with
-    :func:`symcat.wheelrail.wheelset_on_track` and the same ``track``).
+    :func:`symcat.vehicle.wheelset_on_track` and the same ``track``).
 
     Parameters
     ----------
@@ -97,7 +97,7 @@ class WheelRailJoint:
         Constraint form: eq. 22 (default) or eq. 21. Rail frame: rows 0-1 are the coincidence
         of the wheel and rail points along the rail's tangents, row 2 their normal gap (its
         multiplier is minus the normal force), rows 3-4 the tangency; only this form can lift
-        off (:mod:`symcat.integrate.contact_switching`) and run in the embedded formulation.
+        off (:mod:`symcat.wheelrail_events.contact_switching`) and run in the embedded formulation.
         Global: rows 0-2 are the coincidence ``r^w - r^r`` in global components, rows 3-4 the
         tangency; the normal force is minus their multipliers projected on the rail's outward
         normal (``C_s^T lambda = 0`` makes them normal to the rail); a negative one ends the

@@ -36,9 +36,10 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..scene import Bushing, CreepModel, Driving, Revolute, RigidBody, RotationalSpring, Scene, WheelRailJoint
-from ..wheelrail import WheelsetDimensions, wheelset_on_track
+from ..wheelrail import WheelsetDimensions
 from ..wheelrail.track import Curve, Tangent, TrackLayout
 from .parameters import VehicleParameters
+from .placement import wheelset_on_track
 
 BOGIES = ("b1", "b2")          # front (x > 0) and rear
 WHEELSETS = ("ws1", "ws2")     # leading and trailing within a bogie

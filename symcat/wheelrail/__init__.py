@@ -9,11 +9,11 @@ equivalent conicity (EN 15302). NumPy/SciPy only.
   (the search itself in :mod:`.gap_search`);
 * :mod:`.conicity` - equivalent conicity from the rolling radius difference;
 * :mod:`.track` - track layouts (curves, clothoids, cant) and rail frames; :mod:`.track_pieces`
-  their cubic pieces for the constraint contact (:mod:`.constraint_contact`, :mod:`.placement`).
+  their cubic pieces for the constraint contact (:mod:`.constraint_contact`). A wheelset placed
+  on the track for a scene: :func:`symcat.vehicle.wheelset_on_track`.
 """
 from .conicity import equivalent_conicity
 from .geometry import ContactGeometry, TrackCrossSection, WheelsetDimensions, contact_geometry, gauge_point
-from .placement import WheelsetPlacement, wheelset_on_track
 from .profiles import Profile, validate_points
 from .stability import CriticalSpeed, SuspendedWheelset, critical_speed
 from .standard_profiles import (
@@ -55,6 +55,4 @@ __all__ = [
     "s1002",
     "uic60_canted",
     "validate_points",
-    "WheelsetPlacement",
-    "wheelset_on_track",
 ]

@@ -1,5 +1,5 @@
 """All local minima of the wheel/rail gap along the wheel profile (the candidates of a contact
-jump, :mod:`symcat.integrate.contact_jumps`), of one wheel or of many at once.
+jump, :mod:`symcat.wheelrail_events.contact_jumps`), of one wheel or of many at once.
 
 The search evaluates some 750 wheel circles per wheel; one check of a vehicle looks at every
 wheel. :func:`gap_minima_batch` does each of its phases (the circles' bottoms, the two angles of

@@ -1,6 +1,6 @@
 """Lean evaluation of a profile's piecewise cubic (Horner on its ``PPoly`` coefficients).
 
-The contact searches (:mod:`.gap_minima`, :mod:`symcat.integrate.contact_jumps`) evaluate the
+The contact searches (:mod:`.gap_minima`, :mod:`symcat.wheelrail_events.contact_jumps`) evaluate the
 profiles thousands of times per check, mostly on small arrays, where scipy's
 ``BSpline.__call__`` spends about 10 us per call on argument handling. :class:`PiecewiseCubic`
 evaluates the same curve (to rounding: Horner from the piece start instead of de Boor) with a

@@ -25,7 +25,7 @@ rails C1. A linear superelevation ramp, however, has ends that are
 kinks of the rails (the cant rate steps: the raised rail's slope drops by half the ramp's
 gradient, 4 mrad for 80 mm over 10 m) and creases of the rail surfaces; a rigid constraint
 contact crosses them as an impact. With the augmented formulation the driver's contact-jump
-projection (:mod:`symcat.integrate.contact_jumps`) carries the run over; the embedded
+projection (:mod:`symcat.wheelrail_events.contact_jumps`) carries the run over; the embedded
 formulation, whose surface parameters are algebraic, stops there (IDAS failure).
 """
 from __future__ import annotations

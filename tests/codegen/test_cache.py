@@ -111,7 +111,7 @@ def test_compiled_model_dae_on_a_cold_model_cache_does_not_import_sympy(tmp_path
     code = (
         "import sys\n"
         "from tests.codegen.test_model_dae import _wheelset\n"
-        "from symcat.integrate import simulate\n"
+        "from symcat.simulation import simulate\n"
         "from symcat.codegen.model_dae import COMPILED\n"
         "res = simulate(_wheelset(), 0.002, 'augmented', 'ggl', rtol=1e-6, n_out=2, compiled=True)\n"
         "print(int('sympy' in sys.modules), COMPILED['n'], len(res.t_s))\n"

@@ -8,9 +8,10 @@ from symcat.codegen.model_dae import COMPILED, compiled_dae
 from symcat.dae.formulation import Formulation
 from symcat.dae.initial import consistent_state
 from symcat.assembly.multibody import MultibodyModel
-from symcat.integrate import simulate
 from symcat.scene import CreepModel, Driving, PointLoad, RigidBody, Scene, WheelRailJoint
-from symcat.wheelrail import WheelsetDimensions, profile_pair, wheelset_on_track
+from symcat.simulation import simulate
+from symcat.vehicle import wheelset_on_track
+from symcat.wheelrail import WheelsetDimensions, profile_pair
 
 
 def _wheelset(profile="s1002_uic60", creep="polach"):

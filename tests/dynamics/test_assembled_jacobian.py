@@ -12,7 +12,7 @@ which caches what the factory returned), on the DAE the drivers give IDAS:
 
 * the rigid pendulum and the slider on a wire (:func:`symcat.integrate.simulate`'s own
   calls): ``Formulation.dae_function()``, a CasADi graph over the compiled kernels;
-* the wheelset (the contact driver, :mod:`symcat.integrate.contact_stepping`): the DAE in the
+* the wheelset (the contact driver, :mod:`symcat.integrate.event_stepping`): the DAE in the
   state's scaled departure from its linear extrapolation over a call, in normalized, warped
   time (:func:`symcat.integrate.shifted.shifted_dae`), over the compiled whole-model DAE and its
   compiled Jacobian companion ``jac_dae`` (:mod:`symcat.codegen.model_dae`) in the augmented

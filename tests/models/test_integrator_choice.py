@@ -62,7 +62,7 @@ def test_a_combination_that_cannot_run_is_one_line(model, values, message, capsy
 
 
 def test_wheel_rail_contacts_are_refused_by_generalized_alpha_with_their_names():
-    from symcat.integrate.choice import integrate_model
+    from symcat.simulation import integrate_model
     from tests.codegen.test_model_dae import _wheelset
 
     p = {"integrator": "generalized_alpha", "dt": 1e-3, "rho_inf": 0.9}

@@ -11,9 +11,10 @@ from scipy.optimize import curve_fit
 
 from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError
-from symcat.integrate import simulate
 from symcat.scene import CreepModel, Driving, PointLoad, Prismatic, RigidBody, Scene, SpringDamper, WheelRailJoint
-from symcat.wheelrail import contact_geometry, profile_pair, wheelset_on_track
+from symcat.simulation import simulate
+from symcat.vehicle import wheelset_on_track
+from symcat.wheelrail import contact_geometry, profile_pair
 from symcat.wheelrail.creep import KalkerCoefficients
 from symcat.wheelrail.stability import (
     SuspendedWheelset,

@@ -11,10 +11,11 @@ import pytest
 
 from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError, SolverError
-from symcat.integrate import simulate
 from symcat.scene import CreepModel, PointLoad, RigidBody, Scene, WheelRailJoint
 from symcat.scene.rigid import euler_parameters
-from symcat.wheelrail import TrackCrossSection, contact_geometry, profile_pair, wheelset_on_track
+from symcat.simulation import simulate
+from symcat.vehicle import wheelset_on_track
+from symcat.wheelrail import TrackCrossSection, contact_geometry, profile_pair
 from symcat.wheelrail.constraint_contact import WheelRailContact
 from symcat.wheelrail.track import Curve, Irregularities, Tangent, TrackLayout, Transition, rail_offset_for
 

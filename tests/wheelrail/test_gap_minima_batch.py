@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from symcat.scene.rigid import euler_parameters
-from symcat.wheelrail import profile_pair, wheelset_on_track
+from symcat.vehicle import wheelset_on_track
+from symcat.wheelrail import profile_pair
 from symcat.wheelrail.constraint_contact import WheelRailContact, _rotation
 from symcat.wheelrail.gap_minima import gap_minima, gap_minima_batch
 from symcat.wheelrail.track import Curve, TrackLayout, rail_offset_for

@@ -11,7 +11,8 @@ from scipy.integrate import solve_ivp
 
 from symcat.errors import ParameterError
 from symcat.model import run_model
-from symcat.wheelrail import contact_geometry, profile_pair, wheelset_on_track
+from symcat.vehicle import wheelset_on_track
+from symcat.wheelrail import contact_geometry, profile_pair
 from symcat.wheelrail.track import read_irregularities
 
 CONICITY = 0.05

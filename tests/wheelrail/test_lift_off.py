@@ -15,9 +15,10 @@ from scipy.optimize import brentq
 
 from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import SolverError
-from symcat.integrate import simulate
 from symcat.scene import PointLoad, RigidBody, Scene, WheelRailJoint
-from symcat.wheelrail import profile_pair, wheelset_on_track
+from symcat.simulation import simulate
+from symcat.vehicle import wheelset_on_track
+from symcat.wheelrail import profile_pair
 
 G = 9.81
 MASS = 1500.0

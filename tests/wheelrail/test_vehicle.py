@@ -6,9 +6,9 @@ import pytest
 
 from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError
-from symcat.integrate import simulate
 from symcat.model import load_model
 from symcat.scene import Scene
+from symcat.simulation import simulate
 from symcat.vehicle import VehicleParameters, add_vehicle, wheel_forces
 from symcat.wheelrail import profile_pair
 
@@ -48,7 +48,8 @@ def test_off_centre_wheel_loads_sum_to_the_weight_plus_the_vertical_momentum_rat
     0.0357 at 2 mm), fall with it. The vertical wheel forces sum to the weight plus the rate of
     change of the vertical momentum (-120 N, the "missing" 120 N of the summary), to rounding."""
     from symcat.vehicle import momentum_rate_N
-    from symcat.wheelrail import WheelsetDimensions, wheelset_on_track
+    from symcat.wheelrail import WheelsetDimensions
+    from symcat.vehicle import wheelset_on_track
 
     layout, res, forces = _run(profile="s1002_uic60", offset=0.002, t_end=0.01, n_out=1)
     p = layout.parameters

@@ -9,8 +9,8 @@ import pytest
 
 from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError
-from symcat.integrate import simulate
 from symcat.scene import Scene
+from symcat.simulation import simulate
 from symcat.vehicle import (VehicleLayout, add_vehicle, curve_track, lateral_displacement_m, lateral_force_sum_N,
                             steady_curving_forces_N, wheel_forces)
 from symcat.vehicle.wheel_forces import contact_frames

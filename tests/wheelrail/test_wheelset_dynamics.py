@@ -11,10 +11,11 @@ import pytest
 from symcat.assembly.multibody import MultibodyModel
 from symcat.assembly.wheelrail import polach_forces_casadi
 from symcat.errors import ParameterError
-from symcat.integrate import simulate
 from symcat.model import run_model
 from symcat.scene import CreepModel, Driving, RigidBody, Scene, WheelRailJoint
-from symcat.wheelrail import contact_geometry, profile_pair, wheelset_on_track
+from symcat.simulation import simulate
+from symcat.vehicle import wheelset_on_track
+from symcat.wheelrail import contact_geometry, profile_pair
 from symcat.wheelrail.creep import kalker_coefficients, polach_forces
 
 G = 9.81

@@ -10,12 +10,13 @@ import numpy as np
 import pytest
 
 from symcat.assembly.wheelrail import polach_forces_casadi, smooth_positive
-from symcat.integrate.contact_jumps import (FOLD_CURVATURE_PER_M, JUMP_TOLERANCE_M, REFUSED_RADIUS_M, ContactCheck,
-                                            Rival, relative_curvature)
 from symcat.model import run_model
-from symcat.wheelrail import profile_pair, wheelset_on_track
+from symcat.vehicle import wheelset_on_track
+from symcat.wheelrail import profile_pair
 from symcat.wheelrail.constraint_contact import WheelRailContact
 from symcat.wheelrail.creep import kalker_coefficients
+from symcat.wheelrail_events.contact_jumps import (FOLD_CURVATURE_PER_M, JUMP_TOLERANCE_M, REFUSED_RADIUS_M,
+                                                   ContactCheck, Rival, relative_curvature)
 
 G = 9.81
 #: Vertical load per wheel of the wheelset model (its weight and its share of the car body).
@@ -224,7 +225,7 @@ def test_a_jump_to_a_deeper_point_closes_the_gap_in_ggl(index):
     from symcat.assembly.multibody import MultibodyModel
     from symcat.dae.formulation import Formulation
     from symcat.dae.initial import consistent_state
-    from symcat.integrate.contact_jumps import check_contacts, jump_contacts
+    from symcat.wheelrail_events.contact_jumps import check_contacts, jump_contacts
     from symcat.integrate.failure import restart_point, split_state
     from symcat.scene import RigidBody, Scene, WheelRailJoint
 
@@ -318,17 +319,17 @@ def test_a_frictionless_sweep_over_the_conformal_flange_root_is_reported():
 
 def test_a_late_jump_kept_up_to_an_output_matches_the_call_redone_from_its_start(monkeypatch):
     """A call that passed a contact jump unpredicted is kept up to its last output before the
-    crossing (:meth:`ContactStepper._kept_output`) instead of redone from its start: the same
+    crossing (:meth:`ContactEvents.kept_output`) instead of redone from its start: the same
     jumps, no more IDAS steps, and the lateral motion within 5 um of the redone run's (rtol
     1e-6; both jump at an estimated crossing, the kept run from IDAS's interpolated state)."""
-    from symcat.integrate.contact_stepping import ContactStepper
+    from symcat.wheelrail_events.contact_events import ContactEvents
 
     # The tolerances that meet a late jump with an output before it (not the model's default
     # velocity tolerance, whose steps pass no such jump in this second).
     params = dict(profile="s1002_uic60", creep="linear", lateral_offset_m=0.002, t_end=1.0, n_out=50, rtol=1e-6,
                   atol=1e-8, atol_velocity=1e-8)
     kept = _run(**params)
-    monkeypatch.setattr(ContactStepper, "_kept_output", lambda self, *args: None)
+    monkeypatch.setattr(ContactEvents, "kept_output", lambda self, *args: None)
     redone = _run(**params)
     assert kept.stats["jump_redos_kept"] >= 1 and redone.stats["jump_redos_kept"] == 0
     assert kept.stats["contact_jumps"] == redone.stats["contact_jumps"] >= 1

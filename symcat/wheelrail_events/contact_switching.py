@@ -11,7 +11,7 @@ impact (``M dv = -C_q^T Lambda``, no rebound), as in the rigid-body contact of t
 constraint formulation. A wheel/rail model therefore carries one open flag per contact in the
 DAE parameter, next to the time offset.
 
-The switches are located between the driver's short calls (:mod:`.contact_stepping`): a call
+The switches are located between the driver's short calls (:mod:`.contact_events`): a call
 lasts at most half the time the normal force of a closed contact is predicted to take to reach
 zero (linearly from its last two values), or the gap of an open one (from its rate), so the
 calls shorten geometrically toward a switch. A call that passed a switch unpredicted (no rate
@@ -29,8 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..dae.initial import consistent_state
+from ..integrate.failure import physical_coordinates, restart_point, split_state
 from .contact_jumps import FOLD_CURVATURE_PER_M, MIN_SPAN_S
-from .failure import physical_coordinates, restart_point, split_state
 
 #: A contact whose gap exceeds this at the start (m) starts open (a wheelset dropped on its rails).
 INITIAL_OPEN_GAP_M = 1e-5

@@ -1,5 +1,7 @@
-"""The IDAS driver of wheel/rail models: short integrator calls with contact checks between them
-(see :mod:`.contact_jumps` for what is checked and how long a call may be).
+"""The stepping driver of models with events between integrator calls (e.g. wheel/rail contact
+jumps, lift-off and touchdown): short IDAS calls, the events decided between them by plug-in
+handlers (:class:`.events.EventHandler`; the wheel/rail contacts' in
+:mod:`symcat.wheelrail_events`).
 
 The calls are many (tens to hundreds per simulated second while a contact point crosses a nearly
 conformal region) and building an integrator costs a few steps' work (2 ms for the seed vehicle,
@@ -15,11 +17,11 @@ consistent ``z``) and ``D`` are parameters. The scaling ``D = 1 + rtol |x_a| / a
 IDAS's error weights those of ``x`` (its relative part measured on ``xi`` alone would tighten
 the test on large coordinates). This spares both a fresh integrator per call (then 10 ms for a
 compiled DAE, 50 ms over the graph) and IDACalcIC (30 % of the wall time of an S1002 vehicle),
-which remains the last resort (:meth:`ContactStepper._attempts`).
+which remains the last resort (:meth:`EventStepper._attempts`).
 
 Two kinds of call leave the binary grid (*free* calls): a call that ends exactly at a predicted
-contact jump (on the grid, the calls would close in on it by halves: six to eight calls and
-checks per jump), and, from such an end, one call back to the grid at the level the span allows
+event (on the grid, the calls would close in on it by halves: six to eight calls and checks per
+contact jump), and, from such an end, one call back to the grid at the level the span allows
 (on the grid, the calls would double from the finest level up). On an S1002 vehicle this halves
 the calls (170 -> 93 per simulated second). Every call runs in the normalized time
 ``tau = (t - t_a) / h``, so that one integrator serves all calls with the same output fractions
@@ -29,19 +31,11 @@ the S1002 vehicle. A call with one output inside runs in a warped time that puts
 one of a few fixed fractions (:func:`.shifted.warped_grid`), so that such calls share
 integrators too.
 
-A continuing call starts with about IDAS's last step (GGL, :meth:`ContactStepper._first_step`),
-not 1e-3 of the call; a jump found late is redone once, to its estimated time, from the
-call's last output before it if there is one (:mod:`.late_jumps`). S1002 vehicle, rtol 1e-4: 1859 steps, 1081 Jacobian
-set-ups and 109 calls per simulated second became 1098, 534 and 89.
-
-Early jumps: a rival predicted to sink below its followed point within
-:data:`.contact_jumps.EARLY_JUMP_S`, no higher than :data:`EARLY_JUMP_ATOL` of the smallest
-absolute tolerance, is jumped to at once (:meth:`.contact_jumps.ContactCheck.target`), and a
-jump found late by no more than that height is not redone. The wheels of one side of a symmetric
-vehicle reach their jumps microseconds apart; one by one, each cost a call, a check and a
-projection. The point left is refused for twice that horizon, lest the driver jump back to it
-while it still lies below. S1002 vehicle, rtol 1e-4: 89 -> 56 calls, 1098 -> 987 steps and
-534 -> 416 Jacobian set-ups per simulated second.
+A continuing call starts with about IDAS's last step (GGL, :meth:`EventStepper._first_step`),
+not 1e-3 of the call; an event found late is redone once, to its estimated time, from the
+call's last output before it if there is one (:meth:`.events.EventHandler.late`,
+:meth:`~.events.EventHandler.kept_output`). S1002 vehicle, rtol 1e-4: 1859 steps, 1081
+Jacobian set-ups and 109 calls per simulated second became 1098, 534 and 89.
 """
 from __future__ import annotations
 
@@ -53,34 +47,29 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ParameterError, SolverError
-from .contact_jumps import EARLY_JUMP_S, JUMP_TOLERANCE_M, MIN_SPAN_S, check_contacts, jump_contacts, lost_contact
-from .contact_switching import Switching
-from .failure import split_state, stall_reason, sweep_hint
-from .late_jumps import LATE_JUMP_EARLY, kept_output, late_jump_time
 from .shifted import CallIntegrators, call_grid
 
 #: IDAS steps allowed in one call (the driver's ``max_steps`` if smaller).
 MAX_CALL_STEPS = 20000
 #: Largest level ``k`` of a suggested first step ``2^-k`` of the call (about 1e-3).
 FIRST_STEP_LEVELS = 10
-#: The first step of a call that continues the last one (:meth:`ContactStepper._first_step`)
+#: The first step of a call that continues the last one (:meth:`EventStepper._first_step`)
 #: is rounded down to ``2^-k`` of the call with ``k`` a multiple of this: one integrator per
 #: level and grid (about 2 ms to build). With levels 1 apart, S1002 vehicle at rtol 1e-4: 5 %
 #: fewer steps, 12 more integrators, no less wall time.
 FIRST_STEP_LEVEL_STEP = 3
 #: Longest call (s) that falls back to other linear solvers or IDACalcIC when IDAS fails
-#: (:meth:`ContactStepper._attempts`).
+#: (:meth:`EventStepper._attempts`).
 FALLBACK_SPAN_S = 1e-3
-#: Relaxed jumps tried after consecutive failed calls from one state.
-RELAXED_JUMPS = 3
-#: How long (s) a jump target stays refused after IDAS failed from it (see ``advance``).
-REFUSAL_HOLD_S = 1e-3
-#: Height of an early jump's target (:data:`.contact_jumps.EARLY_JUMP_S`) as a fraction of the
-#: smallest absolute tolerance of the state: the rise it gives the wheelset is within IDAS's error.
-EARLY_JUMP_ATOL = 0.1
 #: A run stalls when this many calls fail within :data:`STALL_SPAN_S` of simulated time.
 STALL_FAILURES = 60
 STALL_SPAN_S = 1e-4
+#: Shortest integrator call (s): the floor of the predicted spans and of retries after a failure.
+MIN_SPAN_S = 1e-6
+#: A call that passed an event unpredicted is redone to this fraction of the event's estimated
+#: time (:meth:`.events.EventHandler.overshoot`, :meth:`~.events.EventHandler.late`): the event
+#: is then ahead, and predicted.
+REDO_FRACTION = 0.9
 
 
 class CallFailed(RuntimeError):
@@ -91,56 +80,48 @@ class CallFailed(RuntimeError):
         self.t, self.x, self.z, self.error = t, x, z, error
 
 
-class ContactStepper:
-    """Integrates a wheel/rail model between output times.
+class EventStepper:
+    """Integrates a model with events between output times, the events decided by ``handler``.
 
     Parameters
     ----------
     form : Formulation
     dae_fn : casadi.Function
-        ``(t, x, z, p, u) -> (ode, alg, ...)`` with ``t`` relative to ``p`` (the driver's DAE).
+        ``(t, x, z, p, u) -> (ode, alg, ...)`` with ``t`` relative to ``p`` (the driver's DAE;
+        ``p`` is ``[t_a, *handler.mode()]``).
     opts : dict
         IDAS options.
     x, z : ndarray
         The consistent initial state.
     stats : dict
-        Summed IDAS statistics (``stat_keys``) and the counts ``contact_jumps``,
-        ``contact_calls``, ``contact_retries``, ``contact_fallbacks``, ``contact_refusals``,
-        ``lift_offs``, ``touchdowns``, ``switch_redos`` and ``jump_redos`` (calls redone up to
-        a switch or a contact jump they passed unpredicted,
-        :meth:`.contact_switching.Switching.overshoot`, :meth:`_late_jump`), of which
-        ``jump_redos_kept`` were kept up to an output inside them (:meth:`_kept_output`).
-    open_flags : ndarray, optional
-        Contacts open at the start (:func:`.contact_switching.initial_open`); default none.
+        Summed IDAS statistics (``stat_keys``) and the handler's counts
+        (:attr:`.events.EventHandler.stat_keys`), among them the driver's own under the
+        handler's :attr:`~.events.EventHandler.counter_names`.
+    stat_keys : tuple of str
+        The IDAS statistics summed.
+    handler : EventHandler
+        Attached to ``form`` and ``stats`` (:meth:`~.events.EventHandler.attach`).
     """
 
-    def __init__(self, form, dae_fn, opts: dict, x, z, stats: dict, stat_keys=(), open_flags=None):
+    def __init__(self, form, dae_fn, opts: dict, x, z, stats: dict, stat_keys, handler):
         self.form = form
         self.stats = stats
         self.stat_keys = stat_keys
-        for key in ("contact_jumps", "contact_calls", "contact_retries", "contact_fallbacks", "contact_refusals",
-                    "lift_offs", "touchdowns", "switch_redos", "jump_redos", "jump_redos_kept"):
-            stats.setdefault(key, 0)
-        self.switching = Switching(form, np.zeros(len(form.model.wheelrail)) if open_flags is None else open_flags)
+        self.handler = handler
+        self.counts = handler.counter_names
         # IDAS's own messages on calls the driver retries would only alarm (failures it cannot
         # recover from are reported with the time and the worst residual).
         self.opts = {**{k: v for k, v in opts.items() if k != "init_xdot"}, "calc_ic": True,
                      "disable_internal_warnings": True}
         self.opts.setdefault("reltol", 1e-6)
         # A call is at most one output interval: this many steps mean a singularity (a fold
-        # passed unnoticed), and the retry, shorter and after a jump check, beats waiting.
+        # passed unnoticed), and the retry, shorter and after an event check, beats waiting.
         self.opts["max_num_steps"] = min(int(opts.get("max_num_steps", MAX_CALL_STEPS)), MAX_CALL_STEPS)
         self.set_dae(dae_fn)
         self.step_hint = None  # IDAS's last step in the last call (s), see _first_step
         self.idas_said: list[str] = []  # IDAS's last message on a failed call
         self._start = None  # (t, x_dot) at the last call's start, see _first_step
-        self.refused: dict[str, tuple[float, float]] = {}  # contact -> (wheel parameter, until t)
-        # Height (m) of an early jump's target, and depth of a late one's that is not redone.
-        self.early_m = EARLY_JUMP_ATOL * float(np.min(self._atol(len(x))))
-        self._jumped_from = None  # (t, x, z, [(contact, new wheel parameter)]) of the last jump
-        self.checks = check_contacts(form, x, z)
-        self.span = min(min(c.span_s() for c in self.checks), self.switching.span_s(0.0, z, self.checks))
-        self.event = min(c.event_s() for c in self.checks)
+        self.span, self.event = handler.start(x, z, self._atol(len(x)))
 
     def set_dae(self, dae_fn) -> None:
         """Use ``dae_fn`` from now on (e.g. after a window moved)."""
@@ -155,7 +136,7 @@ class ContactStepper:
         DAE's own ``x_dot``, in time normalized by ``h`` (one integrator serves every length;
         in seconds for calls on the binary grid under a step limit); ``free``: a call off the
         binary grid; see :meth:`_attempts` for the fallbacks."""
-        p = np.r_[t_a, self.switching.open]
+        p = np.r_[t_a, self.handler.mode()]
         grid = [float(v) for v in inner] + [h]
         x = np.asarray(x, float)
         x_dot = np.asarray(self.dae_fn(0.0, x, z, p, ca.DM(0, 1))[0]).ravel()
@@ -164,7 +145,7 @@ class ContactStepper:
         exc = None
         for n, (solver, shifted) in enumerate(self._attempts(h)):
             if n:
-                self.stats["contact_fallbacks"] += 1
+                self.stats[self.counts["fallbacks"]] += 1
             # In time normalized by the call's length, one integrator serves calls of every
             # length with the same output fractions (a step limit in seconds would not).
             limited = "max_step_size" in self.opts
@@ -203,7 +184,7 @@ class ContactStepper:
         """IDAS's first step (s) in a call from ``(t_a, x)`` that continues the last one: its
         last step there (:attr:`step_hint`), at most the step whose order-1 error is half the
         tolerance, ``sqrt(||x''||^-1)`` in IDAS's weighted RMS norm, with ``x''`` the change of
-        ``x_dot`` since the last call's start (none across a jump: ``_start`` is cleared). IDAS
+        ``x_dot`` since the last call's start (none across an event: ``_start`` is cleared). IDAS
         restarts at order 1, whose error test a last step taken at order 3 to 5 fails: on the
         conical vehicle the bare last step took 603 steps per simulated second instead of 417.
         ``None``: no hint (first call, after a failure, index 1: :meth:`_first_step_level`)."""
@@ -251,52 +232,18 @@ class ContactStepper:
             return [(solver, True)]
         return [(solver, True), ("csparse", True), (solver, False)]
 
-    def _late_jump(self, checks_end, h: float, t: float) -> float | None:
-        """:func:`.late_jumps.late_jump_time` of a call of ``h`` seconds from ``t``."""
-        refused = {name: s1 for name, (s1, until) in self.refused.items() if t + h < until}
-        return late_jump_time(self.checks, checks_end, h, refused, self.early_m)
-
-    def _kept_output(self, t: float, offsets, xs, zs, before: float):
-        """:func:`.late_jumps.kept_output` of a call from ``t`` that passed a contact jump."""
-        return kept_output(lambda x, z: check_contacts(self.form, x, z), self._late_jump, t, offsets, xs, zs, before)
-
-    def _after(self, x, z, t, relaxed=False, checks=None):
-        checks = check_contacts(self.form, x, z) if checks is None else checks
-        refused = {name: s1 for name, (s1, until) in self.refused.items() if t < until}
-        x_from, z_from = x, z
-        x, z, jumped = jump_contacts(self.form, x, z, t, checks, relaxed, open_rows=self.switching.open_rows(),
-                                     refused=refused, early_m=self.early_m)
-        self._jumped_from = None
-        if jumped:
-            self.stats["contact_jumps"] += len(jumped)
-            index = {e.joint.name: e.s_index for e in self.form.model.wheelrail}
-            s_from = split_state(self.form, x_from, z_from)["s"]
-            for c in (c for c in checks if c.name in jumped):
-                if c.margin_m(c.target(relaxed, refused.get(c.name), self.early_m)) >= -JUMP_TOLERANCE_M:
-                    # An early jump: the point left lies below the new one until the crossing,
-                    # and the driver must not jump back to it.
-                    self.refused[c.name] = (float(s_from[index[c.name]]), t + 2 * EARLY_JUMP_S)
-            if not relaxed:
-                s = split_state(self.form, x, z)["s"]
-                self._jumped_from = (t, x_from, z_from, [(n, float(s[index[n]])) for n in jumped])
-            checks = check_contacts(self.form, x, z)
-        x, z, switched = self.switching.update(x, z, t, checks)
-        if jumped or switched:
+    def _after(self, x, z, t, checks=None):
+        """The handler's events at ``(t, x, z)``, the next call's limits set (:meth:`.events.EventHandler.after`)."""
+        x, z, changed, self.span, self.event = self.handler.after(x, z, t, checks)
+        if changed:
             self._start = None  # x_dot jumped: no second derivative across
-        if switched:
-            for s in switched:
-                self.stats["lift_offs" if s.kind == "lift-off" else "touchdowns"] += 1
-            checks = check_contacts(self.form, x, z)
-        self.span = min(min(c.span_s() for c in checks), self.switching.span_s(t, z, checks))
-        self.event = min(c.event_s() for c in checks)
-        self.checks = checks
-        return x, z, jumped + [s.name for s in switched]
+        return x, z, changed
 
     def _next_end(self, pos, end: int, k_max: int, dt: float):
         """``(end position, free)`` of the next call from ``pos`` (in units of ``dt / end``, see
         :meth:`advance`; an integer, but for an output time a call was kept up to). On the binary grid: ``dt / 2^k``, the longest not
         beyond the span, from a multiple of it (one integrator per grid serves all such calls).
-        A predicted jump (:meth:`.contact_jumps.ContactCheck.event_s`) that binds the span is
+        A predicted event (the handler's ``event``) that binds the span is
         called to exactly (a free call, :meth:`call`), where calls on the grid would close in on
         it by halves. From off the grid (after such a call), a free call goes to the next
         multiple of the level, or to the one after it when the first is less than a quarter
@@ -316,26 +263,22 @@ class ContactStepper:
         return b, True
 
     def advance(self, x, z, t0: float, times, emit=None):
-        """State at ``times[-1]`` from ``(x, z)`` at ``t0``, with the contacts checked after
-        every call; ``emit(j, x, z)`` receives the state at each of the increasing output
+        """State at ``times[-1]`` from ``(x, z)`` at ``t0``, with the handler's events checked
+        after every call; ``emit(j, x, z)`` receives the state at each of the increasing output
         ``times`` (> ``t0``) as soon as it is known. The output times do not end calls: a call
-        spans as many of them as the contacts allow (:meth:`call`), so that dense output costs
-        no contact checks and no IDAS restarts.
+        spans as many of them as the handler allows (:meth:`call`), so that dense output costs
+        no event checks and no IDAS restarts.
 
-        A failed call is retried from its start after a relaxed jump check (a point about as low;
-        at most :data:`RELAXED_JUMPS` times in a row, lest two vanishing points alternate), else
-        four times shorter. A call that fails right after a jump is retried from the point before
-        it, and the jump target is refused for :data:`REFUSAL_HOLD_S` (two points nanometres
-        apart in depth, IDAS failing from one: jumping back and forth would advance by
-        microseconds per cycle).
+        A failed call is retried from the state the handler's :meth:`~.events.EventHandler.recover`
+        gives if it changed it, else four times shorter.
 
         Raises
         ------
         CallFailed
-            If a call of the shortest length (:data:`MIN_SPAN_S` or just above) fails without a
-            jump to try.
+            If a call of the shortest length (:data:`MIN_SPAN_S` or just above) fails without an
+            event to try, or :data:`STALL_FAILURES` calls fail within :data:`STALL_SPAN_S`.
         SolverError
-            If a wheel runs off its rail or lifts off (:func:`lost_contact`).
+            If the handler ends the run (:meth:`~.events.EventHandler.verify`).
         """
         times = np.atleast_1d(np.asarray(times, float))
         t1 = float(times[-1])
@@ -352,7 +295,7 @@ class ContactStepper:
             t = t0 + dt * pos / end
             t_b = t0 + dt * pos_b / end
             h = t_b - t
-            redo_end = -math.inf  # end (s) of a late jump's redo if the call is kept up to an output
+            redo_end = -math.inf  # end (s) of a late event's redo if the call is kept up to an output
             # Output times strictly inside the call (those within rounding of its end are its end).
             inside = [j for j in range(emitted, len(times) - 1) if times[j] < t_b - 1e-12 * max(1.0, abs(t_b))]
             try:
@@ -360,60 +303,54 @@ class ContactStepper:
                 xs_new, zs_new = self.call(x, z, t, h, inner, free)
             except RuntimeError as exc:
                 self.step_hint = None
-                self.stats["contact_retries"] += 1
+                self.stats[self.counts["retries"]] += 1
                 failures += 1
                 if t - stall_t > STALL_SPAN_S:
                     stall_t, stalled = t, 0
                 stalled += 1
                 if stalled > STALL_FAILURES:
-                    reason = stall_reason(self.checks, exc, STALL_FAILURES, STALL_SPAN_S)
+                    reason = self.handler.stall_reason(exc, STALL_FAILURES, STALL_SPAN_S)
                     raise CallFailed(t, x, z, RuntimeError(reason)) from None
-                if self._jumped_from is not None and self._jumped_from[0] == t:
-                    _, x, z, targets = self._jumped_from
-                    for name, s1 in targets:
-                        self.refused[name] = (s1, t + REFUSAL_HOLD_S)
-                    self.stats["contact_refusals"] += 1
-                    x, z, _ = self._after(x, z, t)
-                    continue
-                x, z, jumped = self._after(x, z, t, relaxed=failures <= RELAXED_JUMPS)
-                if jumped:
+                x, z, retry, self.span, self.event = self.handler.recover(x, z, t, failures)
+                if retry:
+                    self._start = None  # a state the handler changed: no second derivative across
                     continue
                 if h <= shortest:
                     said = f" (IDAS: {self.idas_said[0]})" if self.idas_said else ""
-                    raise CallFailed(t, x, z, RuntimeError(f"{exc}{said}{sweep_hint(self.checks)}")) from None
+                    raise CallFailed(t, x, z, RuntimeError(f"{exc}{said}{self.handler.failure_hint()}")) from None
                 self.span, self.event = h / 4, math.inf
                 continue
             except (SolverError, ParameterError) as exc:
                 raise CallFailed(t, x, z, exc) from None
-            self.stats["contact_calls"] += 1
+            self.stats[self.counts["calls"]] += 1
             failures = 0
             if h > shortest:
                 offsets = inner + [h]
-                t_switch = self.switching.overshoot(z, self.checks, offsets, xs_new, zs_new)
-                if t_switch is not None:
-                    # A switch passed unpredicted: redo the call up to just before it.
-                    self.stats["switch_redos"] += 1
-                    self.span, self.event = max(0.9 * t_switch, MIN_SPAN_S), math.inf
+                t_passed = self.handler.overshoot(z, offsets, xs_new, zs_new)
+                if t_passed is not None:
+                    # An event passed unpredicted: redo the call up to just before it.
+                    self.stats[self.counts["overshoot_redos"]] += 1
+                    self.span, self.event = max(REDO_FRACTION * t_passed, MIN_SPAN_S), math.inf
                     continue
-            checks_end = check_contacts(self.form, xs_new[:, -1], zs_new[:, -1])
+            checks_end = self.handler.check(xs_new[:, -1], zs_new[:, -1])
             if h > shortest:
-                t_late = self._late_jump(checks_end, h, t)
-                redo = None if t_late is None else max(LATE_JUMP_EARLY * t_late, MIN_SPAN_S)
+                t_late = self.handler.late(checks_end, h, t)
+                redo = None if t_late is None else max(REDO_FRACTION * t_late, MIN_SPAN_S)
                 if redo is not None and max(1, round(redo / dt * end)) >= pos_b - pos:
                     # The redo, rounded to the finest grid as :meth:`_next_end` rounds an event,
                     # would be this call again (a crossing a unit or two after its start): keep
-                    # the call, and the check at its end jumps.
+                    # the call, and the check at its end handles the event.
                     redo = None
                 if redo is not None:
-                    # A rival sank below the followed point unpredicted: redo up to before it.
-                    self.stats["jump_redos"] += 1
-                    # A free call to just before it (the rival, then above, is predicted),
-                    # from the last output inside the call before it if there is one.
+                    # An event came unpredicted inside the call: redo up to before it.
+                    self.stats[self.counts["late_redos"]] += 1
+                    # A free call to just before it (then ahead, and predicted), from the last
+                    # output inside the call before it if there is one.
                     self.span = self.event = redo
-                    kept = self._kept_output(t, inner, xs_new, zs_new, self.span)
+                    kept = self.handler.kept_output(t, inner, xs_new, zs_new, self.span)
                     if kept is None:
                         continue
-                    self.stats["jump_redos_kept"] += 1
+                    self.stats[self.counts["late_redos_kept"]] += 1
                     col, checks_col = kept
                     for c in range(col):
                         if emit is not None:
@@ -429,14 +366,14 @@ class ContactStepper:
             emitted += len(inside)
             x, z, _ = self._after(xs_new[:, -1], zs_new[:, -1], t_b, checks=checks_end)
             if redo_end - t_b > MIN_SPAN_S:
-                # Kept up to an output before a late jump: on to the redo's end, as from the start.
+                # Kept up to an output before a late event: on to the redo's end, as from the start.
                 self.span, self.event = min(self.span, redo_end - t_b), min(self.event, redo_end - t_b)
-            # A call ending on an output time emits the state after the contact check (jumps).
+            # A call ending on an output time emits the state after the event check.
             while emitted < len(times) and abs(times[emitted] - t_b) <= 1e-12 * max(1.0, abs(t_b)):
                 if emit is not None:
                     emit(emitted, x, z)
                 emitted += 1
-            reason = lost_contact(self.form, x, z, self.checks)
+            reason = self.handler.verify(x, z)
             if reason is not None:
                 raise SolverError(f"at t = {t_b:.6g} s {reason}")
         return x, z

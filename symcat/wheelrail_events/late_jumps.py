@@ -1,4 +1,4 @@
-"""Contact jumps the contact driver found late (:mod:`.contact_stepping`): when a rival sank
+"""Contact jumps the contact driver found late (:mod:`.contact_events`): when a rival sank
 below the followed point inside a call, and how much of that call is kept."""
 from __future__ import annotations
 
@@ -7,8 +7,6 @@ from typing import Callable
 #: A jump target this deep at a call's end (m) means the jump came late: the call is redone
 #: shorter (:func:`late_jump_time`).
 LATE_JUMP_GAP_M = 1e-8
-#: A late jump's call is redone to this fraction of the estimated crossing (the rival then above).
-LATE_JUMP_EARLY = 0.9
 #: Least fraction of a call that a late jump's redo keeps (:func:`late_jump_time`).
 LATE_JUMP_MIN_FRACTION = 0.25
 

@@ -11,7 +11,7 @@ contact point would have to move infinitely fast). IDAS cannot pass a fold: it s
 (IDA_TOO_MUCH_WORK) or its Newton iterates leave the profiles (IDA_CONV_FAIL, inf/NaN in the
 Jacobian).
 
-So the driver (:mod:`.contact_stepping`) integrates in short calls and, after each, looks at
+So the driver (:mod:`symcat.integrate.event_stepping`, with :mod:`.contact_events`) integrates in short calls and, after each, looks at
 every wheel from scratch (:func:`symcat.wheelrail.gap_minima.gap_minima_batch`, all wheels at
 once). The contact jumps to the lowest other minimum that is *formed* (relative curvature at
 least :data:`FOLD_CURVATURE_PER_M`; a newborn minimum has none and may vanish again) once that
@@ -46,9 +46,10 @@ from ..assembly.wheelrail import GAP_ROW, TANGENCY_ROWS
 from ..dae.formulation import normal_forces_numeric
 from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
+from ..integrate.event_stepping import MIN_SPAN_S
+from ..integrate.failure import physical_coordinates, restart_point, split_state
 from ..wheelrail.contact_point import solve_small
 from ..wheelrail.gap_minima import gap_minima_batch
-from .failure import physical_coordinates, restart_point, split_state
 
 #: A minimum this much below the followed point (m) triggers a jump.
 JUMP_TOLERANCE_M = 1e-9
@@ -65,7 +66,7 @@ OWN_RADIUS_M = 1e-5
 FOLD_CURVATURE_PER_M = 0.05
 #: Largest travel of a followed contact point along the wheel profile between two checks (m).
 TRAVEL_M = 2e-3
-#: A refused jump target (see :class:`.contact_stepping.ContactStepper`) covers the rivals this
+#: A refused jump target (see :class:`.contact_events.ContactEvents`) covers the rivals this
 #: close to it along the wheel profile (m): it travels less in a refusal's hold.
 REFUSED_RADIUS_M = 1e-4
 #: Largest travel (m) on rails with kinks (cant ramps' ends, crossed as impacts: the tangency
@@ -75,8 +76,6 @@ REFUSED_RADIUS_M = 1e-4
 KINK_TRAVEL_M = 5e-4
 #: Gap (m) of a jump target above which a GGL state is projected onto the position constraints.
 GGL_PROJECT_GAP_M = 1e-8
-#: Shortest integrator call (s): the floor of the predicted spans and of retries after a failure.
-MIN_SPAN_S = 1e-6
 
 _TANGENCY = np.array(TANGENCY_ROWS)
 _HELD = np.array([0, 1, 4])  # rows held in relative_curvature (all but the wheel's tangency and the gap)
@@ -190,7 +189,7 @@ class ContactCheck:
         """Predicted time (s) until the lowest formed rival lies :data:`JUMP_TOLERANCE_M` below
         the followed point (the rival part of :meth:`span_s`; ``inf`` if none closes in). A
         call ends there exactly rather than on a binary fraction of the driver's span (see
-        :meth:`.contact_stepping.ContactStepper.advance`)."""
+        :meth:`symcat.integrate.event_stepping.EventStepper.advance`)."""
         formed = [r for r in self.rivals if r.formed]
         if formed and formed[0].gap_rate_m_s < self.gap_rate_m_s:
             closing = self.gap_rate_m_s - formed[0].gap_rate_m_s

@@ -1,6 +1,10 @@
 """Place a wheelset on the track: both wheels touching their rails (the initial state of a
 multibody run with :class:`symcat.scene.WheelRailJoint` contacts), on tangent track or at a
-chainage of a curved track layout."""
+chainage of a curved track layout.
+
+Here, with the scene builders, and not in :mod:`symcat.wheelrail`: the placement is a scene's
+initial state (the rigid body's coordinates, :func:`symcat.scene.rigid.euler_parameters`), and
+the wheel/rail geometry stays below the scene (``tests/test_layers.py``)."""
 from __future__ import annotations
 
 import math
@@ -8,13 +12,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from symcat.errors import ParameterError, SolverError
-
-from .constraint_contact import ContactPoint, WheelRailContact
-from .geometry import TrackCrossSection, WheelsetDimensions, contact_geometry
-from .identity_memo import IdentityMemo
-from .track import TrackLayout
-from .track_pieces import cross_section_of
+from ..errors import ParameterError, SolverError
+from ..scene.rigid import euler_parameters
+from ..wheelrail.constraint_contact import ContactPoint, WheelRailContact
+from ..wheelrail.geometry import TrackCrossSection, WheelsetDimensions, contact_geometry
+from ..wheelrail.identity_memo import IdentityMemo
+from ..wheelrail.track import TrackLayout
+from ..wheelrail.track_pieces import cross_section_of
 
 
 @dataclass
@@ -77,8 +81,9 @@ def wheelset_on_track(wheel, rail, lateral_shift_m: float = 0.0, *, x_m: float =
     yaw_rad : float
         Yaw angle relative to the track tangent (rad), |yaw| < 0.1.
     wheelset, track, cant_rad, track_piece_length_m
-        As for :class:`WheelRailContact` (``track`` a :class:`TrackCrossSection`, ``None`` or a
-        :class:`.track.TrackLayout`).
+        As for :class:`~symcat.wheelrail.constraint_contact.WheelRailContact` (``track`` a
+        :class:`~symcat.wheelrail.TrackCrossSection`, ``None`` or a
+        :class:`~symcat.wheelrail.track.TrackLayout`).
     tol_m : float
         Largest gap left (m).
 
@@ -116,8 +121,6 @@ def wheelset_on_track(wheel, rail, lateral_shift_m: float = 0.0, *, x_m: float =
         return centre + axes @ np.array([0.0, lateral_shift_m, x[0]]), rot
 
     def gaps(x):
-        from symcat.scene.rigid import euler_parameters
-
         pos, rot = state(x)
         q = np.r_[pos, euler_parameters(rot)]
         points = {}
