@@ -34,7 +34,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from ..assembly.multibody import MultibodyModel
-from ..assembly.sparse import to_scipy
+from ..codegen.library import BufferedFunction
 from ..dae.formulation import Formulation
 from ..errors import SolverError
 from ..integrate.results import joint_reactions
@@ -105,13 +105,15 @@ class _Kkt:
         sc, lam = u[n_f + n_s : n_f + n_s + n_sc], u[n_f + n_s + n_sc :]
         k = form.terms(q, ca.MX.zeros(n_f), s, ca.MX.zeros(n_s), ca.MX(t), sc)
         r = ca.vertcat(k["Q"] - ca.mtimes(k["Cq"].T, lam), -ca.mtimes(k["Cs"].T, lam), k["C"], k["T"])
-        self.fn = ca.Function("kkt", [u], [r, ca.jacobian(r, u), k["M"]])
+        self.fn = ca.Function("kkt", [u], [ca.densify(r), ca.jacobian(r, u), k["M"]])
+        self._buffered = BufferedFunction(self.fn)
         self.extras = ca.Function("extras", [u], [k["Cq"], k["gap"], k["fc"]])
         self.n_force = n_f + n_s
+        self.windows = [sl.window for sl in model.windowed()]
 
     def __call__(self, u):
-        r, j, m = self.fn(u)
-        return np.asarray(r).ravel(), to_scipy(j).tocsc(), to_scipy(m).tocsc()
+        r, j, m = self._buffered.sparse(u)
+        return r.toarray().ravel(), j, m
 
 
 def solve_equilibrium(model: MultibodyModel, t: float = 0.0, rtol: float = 1e-9, max_iterations: int = 200,
@@ -143,17 +145,31 @@ def solve_equilibrium(model: MultibodyModel, t: float = 0.0, rtol: float = 1e-9,
     """
     t0 = time.perf_counter()
     saved = [sl.window for sl in model.windowed()]
-    for sl in model.windowed():
-        sl.window = (0, len(sl.element_start) - 1)  # the whole wire: no window moves inside Newton
     try:
+        model.center_windows()
         kkt = _Kkt(model, t)
-        return _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, pseudo_time_step, t0)
+        return _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, pseudo_time_step, t0, t)
     finally:
         for sl, w in zip(model.windowed(), saved):
             sl.window = w
 
 
-def _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, h0, t0):
+def _moved_windows(model, kkt, u, t):
+    """The KKT system of windows centred on the arc lengths of ``u`` when a point nears its
+    window's edge (a window over the whole wire would make the contact's Jacobian block dense
+    over every element: minutes on a line of a few thousand coordinates), else ``kkt``."""
+    n_f, n_s, n_sc, _ = kkt.sizes
+    if not model.windowed():
+        return kkt
+    s = np.r_[u[n_f : n_f + model.n_sliding], u[n_f + n_s : n_f + n_s + n_sc]]
+    if model.window_margin(s) >= 2:
+        return kkt
+    for sl, s_k in zip(model.windowed(), s):
+        model.set_window(sl, float(s_k))
+    return _Kkt(model, t)
+
+
+def _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, h0, t0, t):
     form = kkt.form
     n_f, n_s, n_sc, n_c = kkt.sizes
     u = np.r_[form.to_internal(model.q0[model.free]), model.s0, model.sc0, np.zeros(n_c)]
@@ -187,6 +203,10 @@ def _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, h0, t0):
             history.append((it, h, f_norm, False))
             continue
         u, r, j, mass = u + du, r_new, j_new, mass_new
+        moved = _moved_windows(model, kkt, u, t)
+        if moved is not kkt:
+            kkt = moved
+            r, j, mass = kkt(u)
         # The pseudo time step doubles while the force residual falls, up to max_pseudo_time,
         # where the iteration is Newton's method with a negligible M / h^2 that keeps neutral
         # directions (a free spin) regular.

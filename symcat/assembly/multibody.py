@@ -236,6 +236,15 @@ class MultibodyModel:
         sl.window = new
         return moved
 
+    def center_windows(self) -> bool:
+        """Centre every element window on its point's initial arc length (``s0``, ``sc0``, as
+        a static solution leaves them): an integration must start with its points inside their
+        windows, wherever an earlier run left them. True if one moved."""
+        moved = False
+        for sl, s in zip(self.windowed(), np.r_[self.s0[: self.n_sliding], self.sc0]):
+            moved |= self.set_window(sl, float(s))
+        return moved
+
     def windowed(self) -> list[Sliding]:
         """Sliding joints, then contacts: everything that has an element window."""
         return self.sliding + self.contacts
@@ -297,9 +306,14 @@ class MultibodyModel:
         return names
 
     # --- MX builders --------------------------------------------------------------------------
-    def mass_matrix(self, q: ca.MX) -> ca.MX:
-        m = ca.MX(to_casadi_sparse(sps.block_diag([self.ancf.mass_matrix, sps.csc_matrix((self.n_q - self.ancf.n,) * 2)], format="csc")))
-        if self.scene.rigid_bodies:
+    def mass_matrix(self, q: ca.MX, part: str = "all") -> ca.MX:
+        """Mass matrix (kg, kg m^2); ``part`` as for :meth:`forces` (the ANCF block is the bulk)."""
+        _check_part(part)
+        if part == "rest":
+            m = ca.MX(self.n_q, self.n_q)
+        else:
+            m = ca.MX(to_casadi_sparse(sps.block_diag([self.ancf.mass_matrix, sps.csc_matrix((self.n_q - self.ancf.n,) * 2)], format="csc")))
+        if self.scene.rigid_bodies and part != "bulk":
             idx = np.array([self._rigid_indices(b.name) for b in self.scene.rigid_bodies])
             p = ca.DM(np.array([b.params for b in self.scene.rigid_bodies]).T)
             lib = kernel_library("rigid")
@@ -317,15 +331,22 @@ class MultibodyModel:
             self._rayleigh = to_casadi_sparse(c)
         return self._rayleigh
 
-    def forces(self, q: ca.MX, v: ca.MX, t: ca.MX) -> ca.MX:
-        """All applied, internal and quadratic-velocity forces (N, N m), Rayleigh damping included."""
+    def forces(self, q: ca.MX, v: ca.MX, t: ca.MX, part: str = "all") -> ca.MX:
+        """All applied, internal and quadratic-velocity forces (N, N m), Rayleigh damping included.
+
+        ``part``: ``"all"``; ``"bulk"``, the terms that act on ANCF coordinates only (element
+        forces, Rayleigh damping, force elements between nodes or from a node to the ground),
+        whose Jacobian changes little over a run; ``"rest"``, the others (rigid bodies, force
+        elements with a rigid end). ``bulk + rest = all``; generalized-alpha keeps the bulk's
+        factorized Jacobian and updates the rest's every step."""
+        _check_part(part)
         n_a = self.ancf.n
         f = ca.MX(self.n_q, 1)
-        if n_a:
+        if n_a and part != "rest":
             f += ca.vertcat(self.ancf.force_function()(q[:n_a], v[:n_a]), ca.MX(self.n_q - n_a, 1))
             if self.ancf.rayleigh_matrix is not None:  # Rayleigh damping: constant sparse C times v
                 f -= ca.mtimes(self._rayleigh_dm(), v)
-        if self.scene.rigid_bodies:
+        if self.scene.rigid_bodies and part != "bulk":
             bodies = self.scene.rigid_bodies
             idx = np.array([self._rigid_indices(b.name) for b in bodies])
             p = ca.DM(np.array([b.params for b in bodies]).T)
@@ -337,9 +358,14 @@ class MultibodyModel:
                 weight[rows[:3]] += b.mass * g
             f += ca.DM(weight)
         for lib, group in self.force_groups.items():
-            rows = np.array(group.rows)
+            rows, params = np.array(group.rows), np.array(group.params)
+            if part != "all":
+                keep = (rows.max(axis=1) < n_a) == (part == "bulk")
+                rows, params = rows[keep], params[keep]
+                if not len(rows):
+                    continue
             fn = kernel_library(lib)[lib].map(len(rows))
-            out = fn(_gather(q, rows), _gather(v, rows), t, ca.DM(np.array(group.params).T))
+            out = fn(_gather(q, rows), _gather(v, rows), t, ca.DM(params.T))
             f += ca.mtimes(vector_scatter(rows, self.n_q), ca.vec(out))
         return f
 
@@ -435,6 +461,15 @@ class MultibodyModel:
             r = q[self._rigid_indices(b.name)[:3]]
             u -= b.mass * ca.dot(ca.DM(g), r)
         return u
+
+
+#: The parts of :meth:`MultibodyModel.forces` and :meth:`MultibodyModel.mass_matrix`.
+PARTS = ("all", "bulk", "rest")
+
+
+def _check_part(part: str) -> None:
+    if part not in PARTS:
+        raise ValueError(f"part={part!r}: must be one of {', '.join(PARTS)}")
 
 
 def _gather(x: ca.MX, rows: np.ndarray) -> ca.MX:

@@ -173,6 +173,20 @@ class BufferedFunction:
             flat = np.array(sp.row(), int) * sp.shape[1] + np.array(sp.get_col(), int)
             self._patterns.append((sp.shape, sp.shape[0] * sp.shape[1], flat))
 
+    def sparse(self, *args) -> list:
+        """The outputs as SciPy CSC matrices (patterns read once), at the inputs ``args``."""
+        import scipy.sparse as sps
+
+        if not hasattr(self, "_ccs"):
+            self._ccs = []
+            for i in range(self.function.n_out()):
+                sp = self.function.sparsity_out(i)
+                colind, row = sp.get_ccs()
+                self._ccs.append((np.array(row, int), np.array(colind, int), sp.shape))
+        self._evaluate(args)
+        return [sps.csc_matrix((nz.copy(), row, colind), shape=shape)
+                for nz, (row, colind, shape) in zip(self._outputs, self._ccs)]
+
     def nonzeros(self, *args) -> list[np.ndarray]:
         """The outputs' nonzeros in CasADi's (column-major) order, as new arrays: for a sparse
         output to be built from its pattern (``function.sparsity_out(i).get_ccs()``).

@@ -28,7 +28,7 @@ Wheel/rail contacts in the rail-frame form (eq. 22) may be *open* (lifted off): 
 parameter is ``p = [t0, open]`` with ``open`` 0 or 1 per wheel/rail contact, and an open
 contact's gap row (position, velocity or acceleration level) is replaced by its multiplier
 (``lambda = 0``, in GGL also ``mu = 0``): the surface parameters still follow the closest point
-(the four other rows), and the gap is free. :mod:`symcat.integrate.contact_switching` opens and
+(the four other rows), and the gap is free. :mod:`symcat.wheelrail_events.contact_switching` opens and
 closes them.
 
 Creep forces depend on the normal forces, linear in the multipliers
@@ -139,15 +139,18 @@ class Formulation:
         return y if self._transform is None else self._transform[0] @ y
 
     # --- shared pieces ------------------------------------------------------------------------
-    def terms(self, q_f, v_f, s, w, t, sc=None):
+    def terms(self, q_f, v_f, s, w, t, sc=None, part: str = "all"):
         """Mass matrix, forces and constraint terms in free coordinates (MX); ``sc`` are the
-        contact arc lengths (required when the model has penalty contacts)."""
+        contact arc lengths (required when the model has penalty contacts). ``part="rest"``
+        leaves the bulk's mass and forces out of ``M`` and ``Q`` (see
+        :meth:`~symcat.assembly.multibody.MultibodyModel.forces`); constraints and contacts
+        belong to the rest."""
         m = self.model
         q = self.q_fixed + ca.mtimes(self.P, q_f)
         v = ca.mtimes(self.P, v_f)
         c = m.constraints(q, v, s, w, t)
-        mass = ca.mtimes(self.P.T, ca.mtimes(m.mass_matrix(q), self.P))
-        f = m.forces(q, v, t)
+        mass = ca.mtimes(self.P.T, ca.mtimes(m.mass_matrix(q, part), self.P))
+        f = m.forces(q, v, t, part)
         out = {"T": ca.MX(0, 1), "gap": ca.MX(0, 1), "fc": ca.MX(0, 1)}
         if self.n_sc:
             if sc is None:

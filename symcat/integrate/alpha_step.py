@@ -1,47 +1,212 @@
 """The equations of one generalized-alpha step and their modified Newton solve, for
 :mod:`symcat.integrate.generalized_alpha` (whose module docstring explains the method, the
-unknowns and the scaling)."""
+unknowns and the scaling).
+
+The step's equations are split where the physics splits them. The *bulk* is the ANCF structure
+(element forces, Rayleigh damping, constant mass, node-to-node and node-to-ground force
+elements): on a line, thousands of unknowns with a banded matrix that changes little over a
+run (geometric stiffening, slack droppers). The *rest* is everything that couples bodies to it
+(rigid bodies, joints, sliding joints, penalty contacts, multipliers): few unknowns plus the
+ANCF coordinates of the elements a contact can currently touch (its element window).
+
+- The bulk's residual and Jacobian are CasADi functions built once per run (they do not depend
+  on the windows); its matrix ``A`` is factorized once and kept (:class:`Bulk`).
+- The rest's residual and exact Jacobian are one small function per element window, on the
+  kernels' SX forms and expanded to scalar operations, of only the unknowns the rest depends on:
+  rebuilt in a fraction of a second when a window moves, evaluated in well under a millisecond.
+- The linear solve of each Newton iteration is ``A`` (identity elsewhere) corrected by the
+  rest's exact Jacobian through a Woodbury (capacitance) update on the few unknowns it touches,
+  with the columns ``A^-1 e_i`` of those unknowns cached while the contact stays on an element.
+
+This is how dedicated pantograph/catenary codes keep a constant iteration matrix while the
+contact point moves; refactorizing a 7,000-unknown line whenever the contact crosses an element,
+or differentiating the whole graph, costs more than the rest of the step many times over.
+"""
 from __future__ import annotations
 
 import casadi as ca
 import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
-from ..assembly.sparse import to_scipy
+from ..codegen.library import BufferedFunction, symbolic_kernels
 from ..dae.formulation import Formulation
 from ..errors import SolverError
 
-#: A Newton iteration that contracts by less than this per iteration refactorizes its matrix.
+#: A Newton iteration that contracts by less than this per iteration updates its matrix.
 SLOW_CONTRACTION = 0.3
+#: Cached columns ``A^-1 e_i`` kept at most (a contact touches a dozen or two at a time).
+MAX_COLUMNS = 256
+
+_SINGULAR = ("generalized-alpha: singular iteration matrix (redundant constraints, or a sliding joint at a point "
+             "where its wire has no tangent?)")
+
+
+def _data(p, n_u):
+    """The pieces of the step's data ``p`` (see :class:`StepEquations`)."""
+    return (p[:n_u], p[n_u : 2 * n_u], p[2 * n_u : 3 * n_u], p[3 * n_u], p[3 * n_u + 1], p[3 * n_u + 2],
+            p[3 * n_u + 3])
+
+
+class Bulk:
+    """The window-independent part of the step: the bulk's residual rows and Jacobian as
+    functions of ``(y_b, p, shift_b)`` (the free ANCF coordinates come first among the
+    unknowns, ``n_b`` of them), the constant bulk mass and Rayleigh matrices, the mass matrix
+    of the rest, and the factorized bulk matrix ``A = c_m M + gamma h D + beta h^2 K`` with its
+    cached columns.
+
+    Parameters
+    ----------
+    form : Formulation
+    n_u : int
+        Free coordinates and sliding-joint arc lengths (the layout of ``p``).
+    expand : bool
+        Expand the bulk's functions to SX when the graph allows it.
+    """
+
+    def __init__(self, form: Formulation, n_u: int, expand: bool = False):
+        model = form.model
+        self.n_b = n_b = int(np.count_nonzero(model.free < model.ancf.n))
+        self.n_f, self.n_u = form.n_f, n_u
+        self.lu = None
+        self.bh2 = None
+        self.factorizations = 0
+        self._columns: dict[int, np.ndarray] = {}
+        q_f = ca.MX.sym("q", form.n_f)
+        mass_rest = ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(form.q_fixed + ca.mtimes(form.P, q_f), "rest"),
+                                                  form.P))
+        self._mass_rest = ca.Function("alpha_mass_rest", [q_f], [mass_rest])
+        self.residual = self.jacobian = None
+        if not n_b:
+            return
+        zero = ca.MX(form.n_f - n_b, 1)
+        y_b, shift_b = ca.MX.sym("y_b", n_b), ca.MX.sym("shift_b", n_b)
+        p = ca.MX.sym("p", 3 * n_u + 4)
+        u_pred, v_pred, b, t, bh2, gh, cm = _data(p, n_u)
+        a_b = (y_b - u_pred[:n_b] - shift_b) / bh2
+        q = form.q_fixed + ca.mtimes(form.P, ca.vertcat(y_b, zero))
+        v = ca.mtimes(form.P, ca.vertcat(v_pred[:n_b] + gh * a_b, zero))
+        m_all = ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(q, "bulk"), form.P))
+        f_b = ca.mtimes(form.P.T, model.forces(q, v, t, "bulk"))[:n_b]
+        r_b = bh2 * (ca.mtimes(m_all[:n_b, :n_b], cm * a_b + b[:n_b]) - f_b)
+        fns = [ca.Function("alpha_bulk", [y_b, p, shift_b], [ca.densify(r_b)]),
+               ca.Function("alpha_bulk_jacobian", [y_b, p, shift_b], [ca.jacobian(r_b, y_b)])]
+        if expand:
+            try:
+                fns = [fn.expand() for fn in fns]
+            except RuntimeError:
+                pass
+        # Evaluated in place on NumPy memory: a call with NumPy arguments converts them to DM
+        # and back, which on a line of 7,000 unknowns costs more than the evaluation itself.
+        self.residual, self.jacobian = (BufferedFunction(fn) for fn in fns)
+        m_const = ca.evalf(ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(ca.MX.zeros(model.n_q), "bulk"), form.P)))
+        self.mass_matrix = _csc(m_const)[:n_b, :n_b]
+        c = model.ancf.rayleigh_matrix
+        self.rayleigh = (_csc(ca.evalf(ca.mtimes(form.P.T, ca.mtimes(model._rayleigh_dm(), form.P))))[:n_b, :n_b]
+                         if c is not None else sps.csc_matrix((n_b, n_b)))
+
+    def mass(self, q_f: np.ndarray) -> sps.csc_matrix:
+        """The mass matrix on the free coordinates at ``q_f``."""
+        m = _csc(self._mass_rest(q_f))
+        if self.n_b:
+            m = m + sps.block_diag([self.mass_matrix, sps.csc_matrix((self.n_f - self.n_b,) * 2)], format="csc")
+        return m.tocsc()
+
+    def set(self, y, p, shift) -> None:
+        """Factorize ``A`` at ``(y, p)`` (``shift``: the stabilization's shift of the step)."""
+        self._columns.clear()
+        self.bh2 = float(p[3 * self.n_u + 1])
+        self.factorizations += 1
+        if not self.n_b:
+            self.lu = True
+            return
+        a = self.jacobian.sparse(y[: self.n_b], p, shift[: self.n_b])[0]
+        try:
+            self.lu = spla.splu(a.tocsc())
+        except RuntimeError:
+            raise SolverError("generalized-alpha: singular iteration matrix of the wires (an ANCF coordinate "
+                              "without mass or stiffness?)") from None
+
+    def valid_for(self, bh2: float) -> bool:
+        return self.lu is not None and self.bh2 == bh2
+
+    def solve(self, r: np.ndarray) -> np.ndarray:
+        return self.lu.solve(r) if self.n_b else r
+
+    def columns(self, index: np.ndarray) -> np.ndarray:
+        """``A^-1 e_i`` for each ``i`` of ``index`` (n_b x len(index))."""
+        out = np.empty((self.n_b, index.size))
+        missing = [i for i in index.tolist() if i not in self._columns]
+        if missing:
+            if len(self._columns) + len(missing) > MAX_COLUMNS:
+                self._columns.clear()
+                missing = index.tolist()
+            e = np.zeros((self.n_b, len(missing)))
+            e[missing, np.arange(len(missing))] = 1.0
+            for i, col in zip(missing, self.lu.solve(e).T):
+                self._columns[i] = col
+        for k, i in enumerate(index.tolist()):
+            out[:, k] = self._columns[i]
+        return out
 
 
 class StepEquations:
-    """The step equations of one element window: the scaled residual (with the updated ``a``,
-    ``v`` and ``v_dot``) and its Jacobian as CasADi functions of the unknowns ``y`` and the
-    step's data ``p``, and the factorized iteration matrix of the modified Newton iteration.
+    """The step equations of one element window: the rest's residual and exact Jacobian (one
+    expanded function), with the window-independent :class:`Bulk` (carried over from the
+    previous window's equations) and the split linear solve of the modified Newton iteration.
 
     ``y = [u, beta h^2 lambda (, nu), s_c]`` and the rows ``[dynamics, C_s^T lambda, C (, velocity
     constraints), T]``: the arc lengths ``s_c`` of the penalty contacts are algebraic unknowns of
     the step with their tangency rows ``T(q, s_c) = 0`` (no multiplier; their normal forces are
-    in ``Q``)."""
+    in ``Q``). ``p = [u_pred, v_pred, b, t_{n+1}, beta h^2, gamma h, (1 - alpha_m)/(1 - alpha_f)]``
+    with ``u_pred = u_n + h v_n + h^2 (1/2 - beta) a_n``, ``v_pred = v_n + h (1 - gamma) a_n`` and
+    ``b = (alpha_m a_n - alpha_f v_dot_n) / (1 - alpha_f)``."""
 
-    def __init__(self, form: Formulation, variant: str, expand: bool = False):
+    def __init__(self, form: Formulation, variant: str, expand: bool = False, bulk: Bulk | None = None,
+                 mass_scale: float | None = None):
         n_f, n_s, n_c, n_sc = form.n_f, form.n_s, form.n_c, form.n_sc
         self.n_u, self.n_c, self.n_s, self.n_sc = n_f + n_s, n_c, n_s, n_sc
         n_u = self.n_u
-        n_y = n_u + n_c * (2 if variant == "stabilized" else 1) + n_sc
-        self.n_y = n_y
+        self.n_y = n_y = n_u + n_c * (2 if variant == "stabilized" else 1) + n_sc
+        self.variant, self.form = variant, form
+        self.bulk = bulk if bulk is not None else Bulk(form, n_u, expand)
         y = ca.MX.sym("y", n_y)
-        # p: u_pred = u_n + h v_n + h^2 (1/2 - beta) a_n, v_pred = v_n + h (1 - gamma) a_n,
-        # b = (alpha_m a_n - alpha_f v_dot_n) / (1 - alpha_f), then t_{n+1}, beta h^2, gamma h,
-        # (1 - alpha_m) / (1 - alpha_f).
         p = ca.MX.sym("p", 3 * n_u + 4)
-        u_pred, v_pred, b = p[:n_u], p[n_u : 2 * n_u], p[2 * n_u : 3 * n_u]
-        t, bh2, gh, cm = p[3 * n_u], p[3 * n_u + 1], p[3 * n_u + 2], p[3 * n_u + 3]
+        # The rest depends on few unknowns: entered as a structurally sparse y, its graph and
+        # Jacobian never touch the other thousands.
+        pattern = ca.Function("alpha_rest", [y, p], [self._rows(y, p)[0]]).sparsity_jac(0, 0)
+        self.rest_columns = np.unique(np.array(pattern.get_col(), int))
+        k = self.rest_columns.size
+        y_rest = ca.MX.sym("y_rest", k)
+        y_sparse = ca.MX(ca.Sparsity.triplet(n_y, 1, self.rest_columns.tolist(), [0] * k), y_rest)
+        # Built on the kernels' SX forms and expanded: as scalar operations the rest's Jacobian
+        # evaluates some 30 times faster than through the MX graph.
+        with symbolic_kernels():
+            r_rest, shift = self._rows(y_sparse, p)
+            rest = ca.Function("alpha_rest", [y_rest, p], [ca.densify(r_rest), ca.densify(shift)])
+        try:
+            rest = rest.expand()
+            y_rest, p = rest.sx_in()
+        except RuntimeError:  # a kernel without an SX form: the MX graph
+            y_rest, p = rest.mx_in()
+        r_rest, shift = rest(y_rest, p)
+        self._rest = BufferedFunction(rest)
+        self._rest_jacobian = BufferedFunction(ca.Function("alpha_rest_jacobian", [y_rest, p],
+                                                           [ca.jacobian(r_rest, y_rest)]))
+        self.mass_scale = mass_scale  # kg: mean diagonal of M, converts multiplier updates to positions
+        self._coupling = None
+
+    def _rows(self, y, p):
+        """The rest's scaled residual rows and the stabilization's shift ``G^T nu`` at ``(y,
+        p)``: the step residual without the bulk's mass and forces."""
+        form, variant = self.form, self.variant
+        n_f, n_s, n_c, n_sc, n_u, n_y = form.n_f, self.n_s, self.n_c, self.n_sc, self.n_u, self.n_y
+        u_pred, v_pred, b, t, bh2, gh, cm = _data(p, n_u)
         u, lam_s = y[:n_u], y[n_u : n_u + n_c]
         sc = y[n_y - n_sc :] if n_sc else None
         q, s = u[:n_f], u[n_f:]
-        shift = ca.MX.zeros(n_u)
+        shift = ca.MX(n_u, 1)
         if variant == "stabilized":
             nu = y[n_u + n_c : n_u + 2 * n_c]
             # C_q and C_s depend on positions only: the velocities of this probe are immaterial.
@@ -56,89 +221,153 @@ class StepEquations:
         if variant == "stabilized":
             rows.append(bh2 / gh * (ca.mtimes(k["Cq"], v[:n_f]) + ca.mtimes(k["Cs"], v[n_f:]) + k["Ct"]))
         rows.append(k["T"])
-        r = ca.vertcat(*rows)
-        self.residual_fn, self.update_fn, self.jacobian_fn = _step_functions(
-            ca.Function("alpha_step", [y, p], [r, a, v, v_dot]), expand)
-        self.mass_fn = ca.Function("alpha_mass", [y], [k["M"]])
-        self.lu = None
-        self.lu_bh2 = None  # the beta h^2 of the factorized matrix (a halved step refactorizes)
-        self.factorizations = 0
-        self.mass_scale = None  # kg: mean diagonal of M, converts multiplier updates to positions
+        return ca.vertcat(*rows), shift
 
     @staticmethod
     def _terms(form, q, v, s, w, t, sc=None):
+        k = form.terms(q, v, s, w, t, sc, part="rest")
         if form.n_s == 0:  # an empty s would leave Cs 0 x 0 against n_c rows
-            k = form.terms(q, v, s, w, t, sc)
             return {**k, "Cs": ca.MX(form.n_c, 0)}
-        return form.terms(q, v, s, w, t, sc)
+        return k
+
+    # --- evaluation ---------------------------------------------------------------------------
+    def _rest_values(self, y, p):
+        return self._rest.nonzeros(y[self.rest_columns], p)
 
     def residual(self, y, p) -> np.ndarray:
-        return self.residual_fn(y, p).full().ravel()
+        r, shift = self._rest_values(y, p)
+        n_b = self.bulk.n_b
+        if n_b:
+            r[:n_b] += self.bulk.residual.nonzeros(y[:n_b], p, shift[:n_b])[0]
+        return r
 
     def update(self, y, p) -> tuple:
         """``a``, ``v`` and ``v_dot`` at the end of the step whose unknowns are ``y``."""
-        return tuple(x.full().ravel() for x in self.update_fn(y, p))
+        shift = self._rest_values(y, p)[1]
+        u_pred, v_pred, b, _, bh2, gh, cm = _data(p, self.n_u)
+        a = (y[: self.n_u] - u_pred - shift) / bh2
+        return a, v_pred + gh * a, cm * a + b
 
-    def mass(self, y) -> np.ndarray:
+    def mass(self, y) -> sps.csc_matrix:
         """The mass matrix (free coordinates, scipy sparse) at the positions of ``y``."""
-        return to_scipy(self.mass_fn(y))
+        return self.bulk.mass(y[: self.form.n_f])
 
+    def _rest_triplets(self, y, p):
+        """The rest's exact Jacobian as (rows, columns, values), nonzero values only, with the
+        bulk rows' dependence on ``nu`` through the shift of ``a`` under the stabilized form:
+        ``-(c_m M + gamma h C) G^T`` with the constant bulk mass and Rayleigh matrices."""
+        jac = self._rest_jacobian.sparse(y[self.rest_columns], p)[0].tocoo()
+        keep = jac.data != 0
+        rows, cols, data = jac.row[keep], self.rest_columns[jac.col[keep]], jac.data[keep]
+        n_b, n_u, n_c = self.bulk.n_b, self.n_u, self.n_c
+        if self.variant == "stabilized" and n_b:
+            g = (rows >= n_u) & (rows < n_u + n_c) & (cols < n_b)  # G on the bulk coordinates
+            if np.any(g):
+                _, _, _, _, bh2, gh, cm = _data(p, n_u)
+                g_b = sps.csc_matrix((data[g], (rows[g] - n_u, cols[g])), shape=(n_c, n_b))
+                extra = (-(cm * self.bulk.mass_matrix + gh * self.bulk.rayleigh) @ g_b.T).tocoo()
+                extra.eliminate_zeros()
+                rows = np.r_[rows, extra.row]
+                cols = np.r_[cols, n_u + n_c + extra.col]
+                data = np.r_[data, extra.data]
+        return rows, cols, data
+
+    def jacobian(self, y, p) -> sps.csc_matrix:
+        """The whole step Jacobian at ``(y, p)`` (bulk and rest; the starting acceleration's
+        filter needs it once)."""
+        rows, cols, data = self._rest_triplets(y, p)
+        jac = sps.csc_matrix((data, (rows, cols)), shape=(self.n_y, self.n_y))
+        n_b = self.bulk.n_b
+        if n_b:
+            shift = self._rest_values(y, p)[1]
+            a = self.bulk.jacobian.sparse(y[:n_b], p, shift[:n_b])[0]
+            jac = jac + sps.block_diag([a, sps.csc_matrix((self.n_y - n_b,) * 2)], format="csc")
+        return jac.tocsc()
+
+    # --- the linear solve ---------------------------------------------------------------------
     def factorize(self, y, p) -> None:
-        jac = to_scipy(self.jacobian_fn(y, p))
+        """Refactorize the bulk matrix at ``(y, p)`` and prepare the rest's coupling there."""
         if self.mass_scale is None:
             # The mass matrix's own diagonal: the iteration matrix's also holds beta h^2 K, which
             # on the stiff cross-section gradients of a beam3d wire exceeds the mass by orders.
             diag = np.abs(self.mass(y).diagonal())
             self.mass_scale = float(diag.mean()) if diag.size and diag.mean() > 0 else 1.0
+        self.bulk.set(y, p, self._rest_values(y, p)[1])
+        self.prepare(y, p)
+
+    def prepare(self, y, p) -> None:
+        """The Woodbury update of the rest's exact Jacobian at ``(y, p)``: the unknowns ``K`` it
+        touches (every non-bulk unknown and the bulk ones in a nonzero row or column), the
+        columns ``Z = P^-1 E_K`` (``P`` = bulk matrix, identity elsewhere), and the factorized
+        capacitance ``I + Delta Z_K`` with ``Delta = J_rest[K, K] - I`` on the non-bulk part."""
+        n_b, n_y = self.bulk.n_b, self.n_y
+        r_i, c_i, data = self._rest_triplets(y, p)
+        touched = np.unique(np.concatenate([r_i[r_i < n_b], c_i[c_i < n_b]]))
+        keys = np.concatenate([touched, np.arange(n_b, n_y)])
+        pos = np.full(n_y, -1)
+        pos[keys] = np.arange(keys.size)
+        k = keys.size
+        delta = np.zeros((k, k))
+        np.add.at(delta, (pos[r_i], pos[c_i]), data)
+        n_t = touched.size
+        delta[n_t:, n_t:] -= np.eye(k - n_t)
+        z_bulk = self.bulk.columns(touched) if n_t else np.zeros((n_b, 0))
+        z_k = np.eye(k)
+        if n_t:
+            z_k[:n_t, :n_t] = z_bulk[touched]
         try:
-            self.lu = spla.splu(jac.tocsc())
-        except RuntimeError:
-            raise SolverError("generalized-alpha: singular iteration matrix (redundant constraints, or a sliding "
-                              "joint at a point where its wire has no tangent?)") from None
-        self.lu_bh2 = float(p[3 * self.n_u + 1])
-        self.factorizations += 1
+            cap = sla.lu_factor(np.eye(k) + delta @ z_k)
+        except (ValueError, sla.LinAlgError):
+            raise SolverError(_SINGULAR) from None
+        if np.any(np.diag(cap[0]) == 0):
+            raise SolverError(_SINGULAR)
+        self._coupling = (keys, n_t, delta, z_bulk, cap)
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """``J^-1 rhs`` with ``J = P + E_K Delta E_K^T`` (Woodbury)."""
+        keys, n_t, delta, z_bulk, cap = self._coupling
+        n_b = self.bulk.n_b
+        x = rhs.copy()
+        x[:n_b] = self.bulk.solve(rhs[:n_b])
+        w = sla.lu_solve(cap, delta @ x[keys])
+        x[:n_b] -= z_bulk @ w[:n_t]
+        x[n_b:] -= w[n_t:]
+        return x
 
 
-def _step_functions(step: ca.Function, expand: bool) -> tuple[ca.Function, ca.Function, ca.Function]:
-    """From ``step(y, p) -> (r, a, v, v_dot)``: the residual ``r``, the update ``(a, v, v_dot)``
-    and the Jacobian ``dr/dy`` as separate functions (an iteration evaluates the residual only),
-    with ``expand`` each expanded to scalar operations when the graph allows it (a kernel outside
-    the SX build does not)."""
-    y, p = step.mx_in()
-    r, a, v, v_dot = step(y, p)
-    fns = (ca.Function("alpha_residual", [y, p], [r]), ca.Function("alpha_update", [y, p], [a, v, v_dot]),
-           ca.Function("alpha_jacobian", [y, p], [ca.jacobian(r, y)]))
-    if not expand:
-        return fns
-    try:
-        return tuple(fn.expand() for fn in fns)
-    except RuntimeError:
-        return fns
+def _csc(matrix) -> sps.csc_matrix:
+    """A CasADi sparse matrix as SciPy CSC."""
+    colind, row = matrix.sparsity().get_ccs()
+    return sps.csc_matrix((np.array(matrix.nonzeros()), np.array(row), np.array(colind)), shape=matrix.shape)
 
 
 def solve_step(st: StepEquations, y0, p, n_u, n_c, n_sc, tol, max_iterations, stats, refreshed: bool = False):
-    """Modified Newton iteration of one step from the predictor ``y0``: the factorized matrix is
-    kept while the iteration contracts by at least :data:`SLOW_CONTRACTION` per iteration, else
-    refactorized at the current iterate. Converged when the last update, with the remaining
-    error estimated from the contraction rate, is below ``tol`` relative to the coordinates
-    (``1 + |u|``, and ``1 + |s_c|`` for the contact arc lengths); the scaled multipliers
-    ``beta h^2 lambda`` count as the position change ``beta h^2 lambda / m`` they cause on a mass
-    ``m`` (the mean diagonal of ``M``), and ``nu`` as a position change. Returns
-    ``(y, a, v, v_dot)`` or None."""
+    """Modified Newton iteration of one step from the predictor ``y0``, with the bulk matrix
+    kept and the rest's exact Jacobian at the predictor: when the iteration contracts by less
+    than :data:`SLOW_CONTRACTION` per iteration the rest is re-evaluated at the current iterate,
+    the second time the bulk is refactorized there. Converged when the last update, with the
+    remaining error estimated from the contraction rate, is below ``tol``: an absolute
+    tolerance on the coordinates and contact arc lengths (m, or the dimensionless slopes and
+    Euler parameters), so that it means the same anywhere along a line (a tolerance relative to
+    ``|u|`` would be 100 times looser 100 m down the line than at its start); the scaled
+    multipliers ``beta h^2 lambda`` count as the position change ``beta h^2 lambda / m`` they
+    cause on a mass ``m`` (the mean diagonal of ``M``), and ``nu`` as a position change.
+    Returns ``(y, a, v, v_dot)`` or None."""
     y = y0.copy()
-    fresh = refreshed or st.lu is None
-    if st.lu is None:
+    bh2 = float(p[3 * n_u + 1])
+    fresh = refreshed
+    if not st.bulk.valid_for(bh2) or st.mass_scale is None:
         st.factorize(y, p)
-    n_y = y.size
-    scale = np.empty_like(y)
-    scale[:n_u] = tol * (1.0 + np.abs(y[:n_u]))
+        fresh = True
+    elif not refreshed:
+        st.prepare(y, p)
+    scale = np.full_like(y, tol)
     scale[n_u : n_u + n_c] = tol * st.mass_scale
-    scale[n_u + n_c : n_y - n_sc] = tol
-    scale[n_y - n_sc :] = tol * (1.0 + np.abs(y[n_y - n_sc :]))
     previous = None
+    slow = 0
     for _ in range(max_iterations):
         r = st.residual(y, p)
-        dy = st.lu.solve(-r)
+        dy = st.solve(-r)
         y += dy
         stats["newton_iterations"] += 1
         err = np.abs(dy / scale).max(initial=0.0)
@@ -150,8 +379,13 @@ def solve_step(st: StepEquations, y0, p, n_u, n_c, n_sc, tol, max_iterations, st
         if previous is not None and theta > SLOW_CONTRACTION:
             if fresh and theta >= 1.0:
                 return None  # diverging with an up-to-date matrix
-            st.factorize(y, p)
-            fresh, previous = True, None
+            slow += 1
+            if slow == 1:  # the contact moved on: the rest at the current iterate first
+                st.prepare(y, p)
+            else:
+                st.factorize(y, p)
+                fresh = True
+            previous = None
             continue
         previous = err
     if not fresh:  # a last attempt with an up-to-date matrix from the predictor

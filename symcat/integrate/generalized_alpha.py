@@ -47,11 +47,12 @@ sensitivity to perturbations in the numerical solution of index three differenti
 equations", SIAM J Sci Comput 29:397-414): the dynamic rows are multiplied by ``beta h^2`` and
 the velocity rows by ``beta h / gamma``, so every block of the iteration matrix is O(1) whatever
 ``h`` (unscaled, its condition number grows like a negative power of ``h``). The residual and its
-exact sparse Jacobian are CasADi functions of the step's unknowns and data, built once per
-element window through :meth:`Formulation.terms` (separate functions, so that an iteration does
-not pay for the Jacobian). The iteration is a modified Newton one: the Jacobian is factorized
-(SuperLU) and kept across iterations and steps while the iteration contracts fast, and
-refactorized at the current iterate when it slows. The predictor extrapolates ``a``,
+exact sparse Jacobians are CasADi functions of the step's unknowns and data, built once per
+element window through :meth:`Formulation.terms` and evaluated in place on NumPy memory. The
+iteration is a modified Newton one with the iteration matrix split in two
+(:mod:`.alpha_step`): the bulk (the ANCF structure: thousands of unknowns on a line) is
+factorized (SuperLU) once and kept across steps and window moves, the rest (bodies, joints,
+contacts, multipliers) enters by a low-rank update, re-evaluated when the iteration slows. The predictor extrapolates ``a``,
 ``lambda`` and ``s_c`` linearly from the last two steps. A step whose iteration fails (even with
 a fresh matrix) is retried as two steps of half the size, each halved again on failure, down to
 ``dt / 2**max_halvings``; the next step has the full size again (the Newmark variables are
@@ -78,7 +79,6 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from ..assembly.multibody import MultibodyModel
-from ..assembly.sparse import to_scipy
 from ..dae.formulation import Formulation
 from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
@@ -155,9 +155,12 @@ class _Integrator:
         self.xb, self.zb = form.blocks()
         self.stepper = self._build()
 
-    def _build(self) -> StepEquations:
+    def _build(self, previous: StepEquations | None = None) -> StepEquations:
         build = time.perf_counter()
-        stepper = StepEquations(self.form, self.variant, self.expand)
+        if previous is None:
+            stepper = StepEquations(self.form, self.variant, self.expand)
+        else:  # a window moved: the bulk matrix does not depend on it
+            stepper = StepEquations(self.form, self.variant, self.expand, previous.bulk, previous.mass_scale)
         self.stats["build_s"] = self.stats.get("build_s", 0.0) + time.perf_counter() - build
         return stepper
 
@@ -188,8 +191,6 @@ class _Integrator:
         """One step of size ``h`` from ``s`` at ``t0``; None if its Newton iteration fails."""
         st = self.stepper
         p = self.data(s, t0, h)
-        if st.lu is not None and st.lu_bh2 != p[3 * st.n_u + 1]:
-            st.lu = None  # factorized for another step size
         done = solve_step(st, self.predictor(s, p, h), p, st.n_u, st.n_c, st.n_sc, self.tol, self.max_iterations,
                        self.stats)
         if done is None:
@@ -214,8 +215,7 @@ class _Integrator:
         x, z = self.layout(new)
         if update_windows(self.model, self.form, x, z):
             # The element windows are part of the equations' graph: rebuild them.
-            self.stats["factorizations"] += self.stepper.factorizations
-            self.stepper = self._build()
+            self.stepper = self._build(self.stepper)
             self.stats["rebuilds"] += 1
         return new
 
@@ -281,7 +281,7 @@ class _Integrator:
         p = self.data(s, 0.0, h)
         y = self.predictor(s, p, h)
         keep = np.r_[np.arange(n_u + n_c), np.arange(st.n_y - n_sc, st.n_y)]
-        jac = to_scipy(st.jacobian_fn(y, p)).tocsr()[keep][:, keep].tocsc()
+        jac = st.jacobian(y, p).tocsr()[keep][:, keep].tocsc()
         rhs = np.zeros(keep.size)
         rhs[:n_f] = p[-1] * (st.mass(y) @ delta[:n_f])
         rhs[n_u : n_u + n_c] = jac[n_u : n_u + n_c, :n_u] @ delta  # G delta
@@ -324,6 +324,7 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
         raise ParameterError("generalized-alpha does not handle wheel/rail contacts yet; use simulate() (IDAS) for "
                              "this model")
     wall0 = time.perf_counter()
+    model.center_windows()
     form = Formulation(model, "augmented", "1")
     x, z = consistent_state(form, 0.0)
     # Equal steps no longer than dt, a whole number of them per output interval.
@@ -367,7 +368,7 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
                 check_interrupt(t_s[out], t_end)
     except SolverError as err:
         bar.close()
-        stats["factorizations"] += integ.stepper.factorizations
+        stats["factorizations"] = integ.stepper.bulk.factorizations
         stats["wall_s"] = time.perf_counter() - wall0
         run.multipliers = run.multipliers[: len(run.xs)]
         err.partial = run
@@ -375,7 +376,7 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
             return run
         raise
     bar.close()
-    stats["factorizations"] += integ.stepper.factorizations
+    stats["factorizations"] = integ.stepper.bulk.factorizations
     stats["wall_s"] = time.perf_counter() - wall0
     return run
 
@@ -403,8 +404,9 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
         Stabilized index-2 (order 2 in every variable) or index-3 (order 2 in positions; an O(h)
         transient in velocities and multipliers); see the module's notes.
     tol : float
-        Newton tolerance on the coordinates, relative to ``1 + |u|`` (multipliers counted as the
-        position change they cause, see :func:`~.alpha_step.solve_step`). The iteration stops on the same side
+        Newton tolerance on the coordinates (absolute: m, or the dimensionless slopes and Euler
+        parameters; multipliers counted as the position change they cause, see
+        :func:`~.alpha_step.solve_step`). The iteration stops on the same side
         every step, so its error adds up over the steps: keep ``tol`` well below the step's local
         error (on the double pendulum at dt = 1 ms, 1e-8 tripled the error at 2 s; 1e-10 left it).
     max_iterations : int
