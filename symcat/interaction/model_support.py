@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..model import ModelOutput, Parameter
 from .passage import PassageResult
 
@@ -49,7 +50,13 @@ def central_span_droppers(result: PassageResult) -> list[float]:
 
 
 def passage_output(result: PassageResult, p: dict, stem: str, extra: dict | None = None) -> ModelOutput:
-    """Summary (EN 50318 statistics per pantograph, dropper lengths, run info) and writer."""
+    """Summary (EN 50318 statistics per pantograph, dropper lengths, run info) and writer.
+
+    ``result``: a :class:`~.passage.PassageResult` (lumped pantographs, interaction path) or a
+    :class:`~.scene_passage.ScenePassageResult` (a multibody pantograph on the scene path: the
+    same statistics, plots, ``.npz`` and ParaView series; entries it cannot give are listed
+    under ``not_computed`` with the reason).
+    """
     form = result.form
     summary = {
         "dropper_lengths_m": central_span_droppers(result),
@@ -70,10 +77,13 @@ def passage_output(result: PassageResult, p: dict, stem: str, extra: dict | None
         summary["max_penetration_m"] = float(np.max(rec.penetration_m))
         if p.get("contact") == "bilateral":
             summary["max_constraint_violation_m"] = float(np.max(np.abs(rec.penetration_m[1:])))
-        balance = rec.energy_balance()
-        summary["energy_balance_error_J"] = float(np.abs(balance["error_J"]).max())
-        summary["contact_work_J"] = balance["work_scale_J"]
+        if hasattr(rec, "energy_balance"):  # the interaction path's recorder
+            balance = rec.energy_balance()
+            summary["energy_balance_error_J"] = float(np.abs(balance["error_J"]).max())
+            summary["contact_work_J"] = balance["work_scale_J"]
         summary["slack_dropper_events"] = int(np.sum(np.diff((rec.dropper_tension_N <= 0).astype(int), axis=0) == 1))
+        if getattr(rec, "not_computed", None):  # the multibody path (scene_passage): what it does not have, and why
+            summary["not_computed"] = dict(rec.not_computed)
     summary.update(extra or {})
     stats = dict(rec.stats) if rec is not None else {}
     stats["form_finding_wall_s"] = form.wall_s
@@ -91,3 +101,69 @@ def passage_output(result: PassageResult, p: dict, stem: str, extra: dict | None
         return files
 
     return ModelOutput(summary, stats, {"result": result}, write)
+
+
+#: The pantograph model of a line-scale passage (benchmark2015, en50318).
+PANTOGRAPH_CHOICES = ("lumped", "seo2005")
+PANTOGRAPH_PARAMETER = Parameter(
+    "pantograph", "lumped", "", "pantograph model: lumped (the model's lumped-mass pantograph on the interaction "
+    "path) or seo2005 (the seed paper's four-body pantograph as scene bodies on the multibody path, one pantograph, "
+    "one tension section; its uplift is trimmed to the static contact force)", choices=PANTOGRAPH_CHOICES)
+
+
+def check_scene_pantograph(p: dict, stagger: float, n_pantographs: int = 1, tension_sections: int = 1,
+                           lumped_only: dict | None = None) -> None:
+    """Refuse, before any work, what ``pantograph=seo2005`` cannot run (one line each, naming
+    the parameters, their values and what is allowed).
+
+    Parameters
+    ----------
+    p : dict
+        Model parameters (``pantograph``, ``wires``, ``contact``).
+    stagger : float
+        Contact-wire stagger (m) of the design: bilateral contact needs an unstaggered wire.
+    n_pantographs, tension_sections : int
+        Of the run.
+    lumped_only : dict, optional
+        Parameter name -> (value, default) of parameters that only the lumped pantograph has.
+    """
+    if p.get("pantograph", "lumped") == "lumped":
+        return
+    name = f"pantograph={p['pantograph']}"
+    if n_pantographs != 1:
+        raise ParameterError(f"n_pantographs={n_pantographs} with {name}: the multibody pantograph runs alone "
+                             "(n_pantographs=1); two pantographs need pantograph=lumped")
+    if tension_sections != 1:
+        raise ParameterError(f"tension_sections={tension_sections} with {name}: the multibody passage runs on one "
+                             "tension section (tension_sections=1); overlaps need pantograph=lumped")
+    if p["wires"] != "nonlinear":
+        raise ParameterError(f"wires={p['wires']} with {name}: the catenary scene carries nonlinear wires only "
+                             "(wires=nonlinear)")
+    if p["contact"] == "bilateral" and stagger != 0:
+        raise ParameterError(f"contact=bilateral with {name}: the contact wire is staggered (+/-{abs(stagger):g} m) "
+                             "and the sliding joint would pull it onto the pantograph's plane; allowed: "
+                             "contact=penalty")
+    for key, (value, default) in (lumped_only or {}).items():
+        if value != default:
+            raise ParameterError(f"{key}={value} with {name}: {key} belongs to the lumped pantograph; leave it at "
+                                 f"{default!r} or use pantograph=lumped")
+
+
+def run_scene_pantograph(design, p: dict, speed: float, target_force: float, stem: str, extra: dict,
+                         aero_force: float = 0.0) -> ModelOutput:
+    """Run ``p["pantograph"]`` (a multibody pantograph) over ``design`` at ``speed`` (m/s) with
+    the static contact force ``target_force`` (N) by
+    :func:`~.scene_passage.run_scene_passage`, with the model's numerical and contact
+    parameters; summary and files as :func:`passage_output`, plus the trimmed uplift."""
+    from .scene_passage import run_scene_passage, seo2005_fragment
+
+    fragment = seo2005_fragment(p["contact"], p["contact_stiffness"], p["contact_damping"], aero_force=aero_force)
+    o = numerical_options(p)
+    result = run_scene_passage(design, fragment, speed, target_force, elements_per_span=o["elements_per_span"],
+                               element=o["element"], analysis_spans=o["analysis_spans"], dt=o["dt"],
+                               rho_inf=o["rho_inf"], tol=o["tol"], t_end=o["t_end"], record_every=o["record_every"],
+                               progress=o["progress"], contact=p["contact"])
+    extra = {**extra, "pantograph": p["pantograph"], "uplift_N": result.uplift_N,
+             "static_contact_force_N": result.static_contact_force_N,
+             "target_static_contact_force_N": result.target_force_N, "uplift_static_solves": result.static_solves}
+    return passage_output(result, p, stem, extra)

@@ -50,12 +50,15 @@ def _marks(ax, result, lo, hi) -> None:
 def case_title(result, stem: str) -> str:
     """The case of a passage in words: catenary, speed, pantograph(s), contact model."""
     line, design = result.line, result.form.structure.design
-    names = [r.pantograph.name for r in line.runs]
-    panto = line.runs[0].pantograph
-    kind = f"{names[0]} pantograph ({len(panto.masses)} masses, {panto.uplift:.0f} N static uplift)"
-    if len(names) > 1:
-        spacing = abs(line.runs[0].x_start - line.runs[1].x_start)
-        kind = f"{len(names)} x {kind}, {spacing:g} m apart"
+    if hasattr(result, "pantograph_text"):  # a multibody pantograph (scene_passage)
+        kind = result.pantograph_text()
+    else:
+        names = [r.pantograph.name for r in line.runs]
+        panto = line.runs[0].pantograph
+        kind = f"{names[0]} pantograph ({len(panto.masses)} masses, {panto.uplift:.0f} N static uplift)"
+        if len(names) > 1:
+            spacing = abs(line.runs[0].x_start - line.runs[1].x_start)
+            kind = f"{len(names)} x {kind}, {spacing:g} m apart"
     sections = f", {design.n_sections} tension sections" if design.n_sections > 1 else ""
     presag = 1e3 * max(design.presag) if len(design.presag) else 0.0
     return (f"{stem}: {line.speed * 3.6:g} km/h, {kind}, {line.contact} contact\n"
@@ -208,7 +211,7 @@ def write_paraview_series(result, folder: Path, stem: str = "passage", points_pe
         start += 2 * nd
         step = int(np.argmin(np.abs(t_all - t)))
         x_heads = line.x_contact(t)
-        heads = np.column_stack([x_heads, np.zeros(len(line.runs)), rec.panhead_z_m[step]])
+        heads = np.column_stack([x_heads, np.zeros(len(x_heads)), rec.panhead_z_m[step]])
         points.append(heads)
         lift = heads[:, 2] - np.array([static_contact_height(x) for x in x_heads])
         disp.append(np.column_stack([np.zeros((len(heads), 2)), lift]))

@@ -1,0 +1,457 @@
+"""A line-scale passage of any multibody pantograph under the form-found catenary, on the shared
+multibody pipeline, with the same EN 50318 statistics as :func:`~.passage.run_passage`.
+
+:func:`run_scene_passage` form-finds the catenary (:func:`~symcat.catenary.find_form`), turns it
+into a :class:`~symcat.scene.Scene` (:func:`~symcat.catenary.scene.catenary_scene`), adds a
+pantograph *scene fragment* under the contact wire at the start position of the lumped passage
+(:func:`~.passage.passage_plan`: the same analysis section, lead-in and duration), trims the
+pantograph's uplift so that the static contact force is the target, starts from the joint static
+equilibrium (:func:`~symcat.analysis.equilibrium.solve_equilibrium`) and integrates by
+generalized-alpha (:func:`symcat.integrate.generalized_alpha`, one output per step). The contact
+force history goes through the same statistics function as the lumped passage
+(:func:`~.passage.pantograph_statistics`), and the histories are recorded under the same names
+as :class:`~.recorder.PassageRecorder`'s (:class:`SceneRecord`), so that the summary, the plots,
+the ``.npz`` and the ParaView series of :func:`~.model_support.passage_output` serve both paths.
+
+Your own pantograph
+-------------------
+A pantograph fragment is a callable
+
+    ``add(scene, wire, x0, speed, uplift) -> contact_name``
+
+that adds the pantograph's bodies, joints and force elements to ``scene`` (a
+:class:`~symcat.scene.Scene` holding the catenary), with its pan-head under the ANCF body
+``wire`` at ``x0`` (m along the line, the pantograph standing in the plane y = 0, moving along
++x at ``speed`` m/s: a driven carrier), its static uplift ``uplift`` (N) applied where the
+pantograph's uplift acts, and returns the name of its pan-head/wire contact: a
+:class:`~symcat.scene.PenaltyContact` (loss of contact allowed; works on a staggered wire) or a
+:class:`~symcat.scene.SlidingJoint` (bilateral; for a wire in the plane y = 0 only). Wrap it
+in a :class:`ScenePantograph` with a first guess of the uplift and a name::
+
+    from symcat.catenary import benchmark2015
+    from symcat.interaction.scene_passage import ScenePantograph, run_scene_passage
+    from symcat.pantograph.lumped_scene import wire_height
+    from symcat.scene import Driving, PenaltyContact, PointLoad, Prismatic, RigidBody, SpringDamper
+
+    def my_pantograph(scene, wire, x0, speed, uplift):
+        z, s0, _ = wire_height(scene, wire, x0)           # the wire's height and arc length at x0
+        v = (speed, 0.0, 0.0)
+        scene.add(RigidBody("roof", 50.0, (1, 1, 1), (x0, 0, z - 1.0), velocity=v))
+        scene.add(Prismatic("track", "roof", "ground", at=(x0, 0, z - 1.0), axis=(1, 0, 0)))
+        scene.add(Driving("drive", "roof", direction=(1, 0, 0), velocity=speed))
+        scene.add(RigidBody("head", 8.0, (0.1, 0.1, 0.1), (x0, 0, z), velocity=v))
+        scene.add(Prismatic("guide", "head", "roof", at=(x0, 0, z), axis=(0, 0, 1)))
+        scene.add(SpringDamper("suspension", "roof", "head", at_i=(x0, 0, z - 1.0), at_j=(x0, 0, z),
+                               stiffness=500.0, damping=50.0, free_length=1.0))
+        scene.add(PointLoad("uplift", "head", force=(0, 0, uplift)))
+        scene.add(PenaltyContact("head_contact", wire, "head", s0=s0, stiffness=5e4, damping=0.0))
+        return "head_contact"
+
+    res = run_scene_passage(benchmark2015(5), ScenePantograph(my_pantograph, uplift=160.0, name="mine"),
+                            200 / 3.6, target_force=90.0, elements_per_span=10)
+    res.statistics[0]["contact_force_std_N"], res.uplift_N, res.record.contact_force_N
+
+The uplift trim solves the static state twice (and more only if the force is not affine in the
+uplift to ``force_rtol``: the pantograph's geometry changes a little with its height): the
+static contact force of a pantograph pressing on the wire is affine in its uplift. The seed
+paper's four-body pantograph plugs in through the same mechanism (:func:`seo2005_fragment`).
+
+Limits: one pantograph, one tension section (no overlaps), the nonlinear wires (no
+``wires="linear"``). Not recorded on this path (a :class:`SceneRecord` lists them in
+``not_computed``): the energy balance of the passage and the Newton iterations per step.
+"""
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..catenary.design import CatenaryDesign
+from ..catenary.formfinding import FormFindingResult, find_form
+from ..errors import ParameterError, SolverError
+from ..progress import notice
+from .passage import pantograph_statistics, passage_plan
+
+#: ``add(scene, wire, x0, speed, uplift) -> contact name`` (module docstring).
+PantographFragment = Callable[..., str]
+
+#: Why a :class:`SceneRecord` has no value for these summary entries.
+NOT_COMPUTED = {
+    "energy_balance_error_J": "not recorded on the multibody path (the energy balance of the moving contact is "
+                              "computed by the interaction path's recorder only)",
+    "contact_work_J": "not recorded on the multibody path",
+    "newton_iterations_per_step": "not recorded per step on the multibody path (stats holds the total)",
+}
+
+
+@dataclass
+class ScenePantograph:
+    """A pantograph scene fragment for :func:`run_scene_passage`.
+
+    Attributes
+    ----------
+    add : callable
+        ``add(scene, wire, x0, speed, uplift) -> contact name`` (module docstring); units m,
+        m/s, N.
+    uplift : float
+        First guess of the uplift (N) that gives the target static contact force.
+    name : str
+        Shown in plot titles and the summary.
+    description : str
+        One line about the model (plot titles).
+    """
+
+    add: PantographFragment
+    uplift: float = 100.0
+    name: str = "pantograph"
+    description: str = ""
+
+
+def seo2005_fragment(contact: str = "penalty", contact_stiffness: float = 5.0e4, contact_damping: float = 0.0,
+                     contact_smoothing: float = 1.0e-5, aero_force: float = 0.0, rod_stiffness: float = 5.0e5,
+                     prefix: str = "pantograph_") -> ScenePantograph:
+    """The seed paper's four-body pantograph (:func:`symcat.pantograph.add_seo2005_pantograph`)
+    as a :class:`ScenePantograph`.
+
+    Parameters
+    ----------
+    contact : {"penalty", "bilateral"}
+        Pan-head/wire contact (bilateral: a sliding joint, for an unstaggered wire only).
+    contact_stiffness, contact_damping, contact_smoothing : float
+        Penalty law (N/m, N s/m, m).
+    aero_force : float
+        Constant aerodynamic uplift (N) on the pan-head (``c v^2`` at the run's speed).
+    rod_stiffness : float
+        Coupling rod (N/m).
+    prefix : str
+        Before every element name.
+    """
+    from ..pantograph.seo2005 import add_seo2005_pantograph
+    from ..scene import PointLoad
+
+    def add(scene, wire, x0, speed, uplift):
+        names = add_seo2005_pantograph(scene, wire, x0, None, contact, None, speed, uplift, rod_stiffness,
+                                       contact_stiffness, contact_damping, contact_smoothing, prefix=prefix)
+        if aero_force:
+            scene.add(PointLoad(prefix + "aero", names["panhead"], force=(0.0, 0.0, float(aero_force))))
+        return names["contact"]
+
+    return ScenePantograph(add, uplift=265.0, name="seo2005",
+                           description="seo2005 four-body pantograph")
+
+
+class SceneRecord:
+    """Histories of a :func:`run_scene_passage`, under :class:`~.recorder.PassageRecorder`'s names
+    (one pantograph, one contact wire).
+
+    Attributes (NumPy arrays, SI units in the names)
+    ------------------------------------------------
+    t_s : (n,)
+    x_contact_m, contact_force_N, penetration_m, panhead_z_m, panhead_acc_m_s2 : (n, 1)
+        Pan-head position along the line, contact force, penetration (minus the normal gap;
+        bilateral: the largest constraint violation of the step), height and vertical
+        acceleration of the pan-head's body.
+    contact_force_wire_N : (n, 1, 1)
+    support_z_m : (n, n_supports)
+    dropper_tension_N : (n, n_droppers)
+    snapshot_t_s : (n_snapshots,), snapshot_q : (n_snapshots, n_catenary_coordinates)
+    static_support_z_m : (n_supports,)
+        Contact-wire heights at the supports of the static catenary without pantographs.
+    uplift_N, static_contact_force_N : float
+    stats : dict
+        The integrator's statistics (``wall_s``, ``steps``, ...).
+    not_computed : dict
+        Summary entries this path does not have, and why.
+    """
+
+    def __init__(self, arrays: dict, form: FormFindingResult, speed: float, stats: dict):
+        self._arrays = arrays
+        self._form = form
+        self._speed = speed
+        self.stats = stats
+        self.not_computed = dict(NOT_COMPUTED)
+
+    def __getattr__(self, name):
+        arrays = self.__dict__.get("_arrays", {})
+        if name in arrays:
+            return arrays[name]
+        raise AttributeError(name)
+
+    @property
+    def static_support_z_m(self) -> np.ndarray:
+        st = self._form.structure
+        return np.asarray(self._form.q)[st.cw_xyz[st.support_nodes, 2]]
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """Every recorded array by name (as :meth:`PassageRecorder.arrays`, without the
+        per-step iterations, work and dissipation)."""
+        st = self._form.structure
+        out = dict(self._arrays)
+        out.update(station_x_m=st.x, support_x_m=st.x[st.support_nodes], dropper_x_m=st.x[st.dropper_nodes],
+                   dropper_length_m=st.dropper_length, static_support_z_m=self.static_support_z_m,
+                   speed_m_s=np.array(self._speed))
+        return out
+
+    def save(self, path) -> Path:
+        """Write every array to ``path`` (.npz; :func:`~.recorder.load_passage` reads it)."""
+        path = Path(path)
+        np.savez_compressed(path, **self.arrays())
+        return path
+
+
+class SceneLine:
+    """What the passage outputs (:mod:`.output`) need of the line: speed, contact model, the
+    static catenary and where the pan-head is."""
+
+    def __init__(self, form: FormFindingResult, speed: float, contact: str, n: int, record: SceneRecord | None,
+                 x_start: float):
+        self.speed, self.contact, self.n = speed, contact, n
+        self.q_static = np.asarray(form.q, float).copy()
+        self._record, self.x_start = record, x_start
+
+    def x_contact(self, t: float) -> np.ndarray:
+        """Pan-head position(s) (m) at ``t`` (s), from the record."""
+        rec = self._record
+        if rec is None:
+            return np.array([self.x_start])
+        return np.array([np.interp(t, rec.t_s, rec.x_contact_m[:, 0])])
+
+
+@dataclass
+class ScenePassageResult:
+    """Outcome of :func:`run_scene_passage` (the fields :func:`~.model_support.passage_output`
+    reads, as :class:`~.passage.PassageResult`'s).
+
+    Attributes
+    ----------
+    form : FormFindingResult
+    line : SceneLine
+    record : SceneRecord or None (static only)
+    section_m : (float, float)
+        Analysis section (m).
+    statistics : list of dict
+        EN 50318 statistics (one pantograph).
+    uplift_N : float
+        Uplift (N) the trim found.
+    static_contact_force_N : float
+        Static contact force (N) with it.
+    target_force_N : float
+    static_solves : int
+        Static equilibria solved by the trim.
+    pantograph : ScenePantograph
+    model : MultibodyModel
+    simulation : SimulationResult or None
+    wall_s, simulated_s : float
+    """
+
+    form: FormFindingResult
+    line: SceneLine
+    record: SceneRecord | None
+    section_m: tuple[float, float]
+    statistics: list[dict] = field(default_factory=list)
+    uplift_N: float = 0.0
+    static_contact_force_N: float = 0.0
+    target_force_N: float = 0.0
+    static_solves: int = 0
+    pantograph: ScenePantograph | None = None
+    model: object = None
+    simulation: object = None
+    wall_s: float = 0.0
+    simulated_s: float = 0.0
+
+    def pantograph_text(self) -> str:
+        """The pantograph in words (plot titles)."""
+        p = self.pantograph
+        what = p.description or f"{p.name} pantograph"
+        return f"{what} ({self.uplift_N:.1f} N uplift, {self.static_contact_force_N:.0f} N static contact force)"
+
+
+def _contact_element(scene, name: str):
+    from ..scene import PenaltyContact, SlidingJoint
+
+    for e in scene.force_elements + scene.joints:
+        if e.name == name and isinstance(e, (PenaltyContact, SlidingJoint)):
+            return e
+    raise ParameterError(f"pantograph fragment: returned {name!r}, which is not a PenaltyContact or SlidingJoint of "
+                         "the scene; it must return the name of its pan-head/wire contact")
+
+
+def static_force(eq, element) -> float:
+    """Static contact force (N, pressing the pan-head down) of the contact ``element`` in the
+    equilibrium ``eq``: the penalty force, or minus the sliding joint's vertical reaction."""
+    from ..scene import PenaltyContact
+
+    if isinstance(element, PenaltyContact):
+        return float(eq.contact_force_N[element.name])
+    return -float(eq.reactions_N[element.name][2])
+
+
+def _static(form, pantograph: ScenePantograph, wire: str, x0: float, speed: float, uplift: float):
+    """Scene, model, contact element and equilibrium with ``uplift`` (N)."""
+    from ..analysis.equilibrium import solve_equilibrium
+    from ..assembly.multibody import MultibodyModel
+    from ..catenary.scene import catenary_scene
+
+    scene = catenary_scene(form)
+    name = pantograph.add(scene, wire, x0, speed, float(uplift))
+    element = _contact_element(scene, name)
+    model = MultibodyModel(scene)
+    eq = solve_equilibrium(model)
+    return scene, model, element, eq
+
+
+def trim_uplift(form, pantograph: ScenePantograph, target_force: float, wire: str, x0: float, speed: float,
+                force_rtol: float = 1e-9, max_solves: int = 8):
+    """The uplift (N) whose static contact force is ``target_force`` (N): two static solves
+    (the force is affine in the uplift), then secant steps while the force is off by more than
+    ``force_rtol`` relative (the pantograph's geometry moves slightly with its height).
+
+    Returns
+    -------
+    uplift, force, (scene, model, element, eq), solves
+        The uplift (N), its static force (N), the static state built with it and the number of
+        static solves.
+    """
+    u0 = float(pantograph.uplift)
+    built = _static(form, pantograph, wire, x0, speed, u0)
+    f0 = static_force(built[3], built[2])
+    solves = 1
+    u1 = u0 + (target_force - f0)  # unit sensitivity as the first guess (uplift at the pan-head)
+    while solves < max_solves:
+        if abs(f0 - target_force) <= force_rtol * abs(target_force):
+            return u0, f0, built, solves
+        built1 = _static(form, pantograph, wire, x0, speed, u1)
+        f1 = static_force(built1[3], built1[2])
+        solves += 1
+        if not (f1 > 0 or f0 > 0):
+            raise ParameterError(f"pantograph {pantograph.name}: no contact at uplifts {u0:g} N and {u1:g} N; give a "
+                                 "first uplift guess that presses the pan-head on the wire")
+        slope = (f1 - f0) / (u1 - u0) if u1 != u0 else 0.0
+        if not slope > 0:
+            raise SolverError(f"pantograph {pantograph.name}: the static contact force does not grow with the uplift "
+                              f"({f0:g} N at {u0:g} N, {f1:g} N at {u1:g} N)")
+        u0, f0, built = u1, f1, built1
+        u1 = u1 + (target_force - f1) / slope
+    if abs(f0 - target_force) <= force_rtol * abs(target_force):
+        return u0, f0, built, solves
+    raise SolverError(f"pantograph {pantograph.name}: the uplift trim did not reach the static contact force "
+                      f"{target_force:g} N in {max_solves} static solves (last {f0:g} N at {u0:g} N uplift)")
+
+
+def _record(res, form, model, element, snapshot_every: float) -> dict:
+    """The SceneRecord arrays of a SimulationResult."""
+    from ..scene import PenaltyContact
+
+    st = form.structure
+    q = np.asarray(res.q)
+    head = model.rigid_offset[element.body]
+    if isinstance(element, PenaltyContact):
+        c = res.contacts[element.name]
+        force, penetration = np.asarray(c["force_N"]), -np.asarray(c["gap_m"])
+    else:
+        force = -np.asarray(res.reactions_N[element.name])[:, 2]
+        penetration = np.asarray(res.position_drift)
+    t = np.asarray(res.t_s)
+    snap = [0]
+    for k in range(1, len(t)):
+        if t[k] >= t[snap[-1]] + snapshot_every - 1e-12:
+            snap.append(k)
+    q_cat = q[:, : st.n]
+    return {
+        "t_s": t,
+        "x_contact_m": q[:, head][:, None],
+        "contact_force_N": force[:, None],
+        "contact_force_wire_N": force[:, None, None],
+        "penetration_m": penetration[:, None],
+        "panhead_z_m": q[:, head + 2][:, None],
+        "panhead_acc_m_s2": np.asarray(res.a)[:, head + 2][:, None],
+        "support_z_m": q_cat[:, st.cw_xyz[st.support_nodes, 2]],
+        "dropper_tension_N": np.array([st.dropper_state(qk)[2] for qk in q_cat]),
+        "snapshot_t_s": t[snap],
+        "snapshot_q": q_cat[snap],
+    }
+
+
+def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed: float, target_force: float,
+                      elements_per_span: int = 60, element: str = "cable3d", analysis_spans: int = 2,
+                      lead_in: float | None = None, dt: float = 1e-3, rho_inf: float = 0.8, tol: float = 1e-4,
+                      t_end: float | None = None, record_every: float = 0.05, progress: bool = True,
+                      form: FormFindingResult | None = None, wire: str = "contact", contact: str = "penalty",
+                      force_rtol: float = 1e-9) -> ScenePassageResult:
+    """Run a multibody ``pantograph`` over the form-found ``design`` at ``speed`` (m/s) with the
+    static contact force ``target_force`` (N); EN 50318 statistics as :func:`~.passage.run_passage`.
+
+    Parameters
+    ----------
+    design : CatenaryDesign
+        One tension section.
+    pantograph : ScenePantograph
+        The fragment (module docstring) and a first guess of its uplift.
+    speed : float
+        Train speed (m/s), > 0.
+    target_force : float
+        Static contact force (N) the uplift is trimmed to.
+    elements_per_span, element, analysis_spans, lead_in, t_end
+        As :func:`~.passage.run_passage`: the same section, start position (the lumped
+        passage's) and duration (s; ``t_end=0``: the static state only).
+    dt, rho_inf : float
+        Generalized-alpha step (s) and spectral radius at infinity.
+    tol : float
+        Generalized-alpha's Newton tolerance on the coordinates (m; absolute, so the same
+        anywhere along the line).
+    record_every : float
+        Interval (s) of the wire snapshots (ParaView).
+    progress : bool
+        Progress bar of the integration.
+    form : FormFindingResult, optional
+        A form-found ``design`` (skips form finding).
+    wire : str
+        Scene name of the contact wire (``catenary_scene``: ``"contact"``).
+    contact : str
+        The contact model in words (plot titles); the fragment decides the actual one.
+    force_rtol : float
+        Relative accuracy of the static contact force.
+
+    Returns
+    -------
+    ScenePassageResult
+    """
+    from ..integrate import generalized_alpha
+
+    t0 = time.perf_counter()
+    if design.n_sections != 1:
+        raise ParameterError(f"tension_sections={design.n_sections}: a scene passage runs on one tension section (1)")
+    if not speed > 0:
+        raise ParameterError(f"speed={speed:g} m/s: must be > 0")
+    if not target_force > 0:
+        raise ParameterError(f"target_force={target_force:g} N: must be > 0")
+    section, x0, duration = passage_plan(design, 1, speed, 200.0, analysis_spans, lead_in, t_end)
+    if form is None:
+        form = find_form(design, elements_per_span, element, progress=progress)
+    if progress:
+        notice(f"trimming the uplift of the {pantograph.name} pantograph to a static contact force of "
+               f"{target_force:g} N (static solves of the joint equilibrium)")
+    uplift, f_static, (_, model, el, eq), solves = trim_uplift(form, pantograph, target_force, wire, x0, speed,
+                                                                   force_rtol)
+    eq.apply(model)
+    line = SceneLine(form, speed, contact, model.n_q, None, x0)
+    out = ScenePassageResult(form, line, None, section, [], uplift, f_static, float(target_force), solves, pantograph,
+                             model)
+    if duration == 0:
+        out.wall_s = time.perf_counter() - t0
+        return out
+    n_steps = math.ceil(duration / dt - 1e-9)
+    res = generalized_alpha(model, duration, dt, rho_inf, n_out=n_steps, tol=tol, progress=progress)
+    rec = SceneRecord(_record(res, form, model, el, record_every), form, speed, dict(res.stats))
+    rec.uplift_N, rec.static_contact_force_N = uplift, f_static
+    line._record = rec
+    stats = [pantograph_statistics(rec.t_s, rec.x_contact_m[:, 0], rec.contact_force_N[:, 0], section,
+                                   form.structure, rec.support_z_m, rec.static_support_z_m)]
+    out.record, out.statistics, out.simulation = rec, stats, res
+    out.simulated_s = float(rec.t_s[-1])
+    out.wall_s = time.perf_counter() - t0
+    return out
