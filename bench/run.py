@@ -211,6 +211,10 @@ def main():
     from bench.pantograph import section as pantograph_section
 
     pantograph = pantograph_section(REPORT)
+    print("line passage on the shared multibody path ...", flush=True)
+    from bench.unified_passage import section as line_section
+
+    line = line_section()
     print("wheelset ...", flush=True)
     from bench.wheelset import section as wheelset_section
 
@@ -277,6 +281,7 @@ def main():
         "",
         *pantograph,
         "",
+        *line,
         *wheelset,
         *vehicle,
         *model_dae,

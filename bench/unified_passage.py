@@ -29,7 +29,7 @@ STARTUP_S = 0.1
 
 
 def compare(n_spans=4, elements=10, speed_kmh=320.0, t_end=1.0, dt=1e-3, rho_inf=0.8, idas=False,
-            contact_stiffness=5.0e4, smoothing=1e-5, progress=False, tol_ip=1e-4) -> dict:
+            contact_stiffness=5.0e4, smoothing=1e-5, progress=False, tol_ip=1e-4, tol_mb=1e-4) -> dict:
     """Run both paths; return histories, statistics and wall times."""
     speed = speed_kmh / 3.6
     design = benchmark2015(n_spans)
@@ -59,7 +59,8 @@ def compare(n_spans=4, elements=10, speed_kmh=320.0, t_end=1.0, dt=1e-3, rho_inf
     wall_build = time.perf_counter() - t0
     n_out = round(t_end / dt)
     t0 = time.perf_counter()
-    res = generalized_alpha(model, t_end, dt, rho_inf, n_out=n_out, progress=progress)
+    res = generalized_alpha(model, t_end, dt, rho_inf, n_out=n_out, progress=progress, tol=tol_mb,
+                            multipliers="integrator")
     wall_mb = time.perf_counter() - t0
     t_b, f_b = res.t_s, res.contacts[info["contact"]]["force_N"]
     out = {"x0_m": x0, "static_force_ip_N": float(f_a[0]), "static_force_mb_N": float(eq.contact_force_N[info["contact"]]),
@@ -92,6 +93,40 @@ def compare(n_spans=4, elements=10, speed_kmh=320.0, t_end=1.0, dt=1e-3, rho_inf
         out.update(mean_idas_N=float(fc[keep].mean()), std_idas_N=float(fc[keep].std()),
                    max_abs_diff_idas_N=float(np.abs(d2).max()), rms_diff_idas_N=float(np.sqrt(np.mean(d2**2))))
     return out
+
+
+def section(spans=(10, 20, 40, 80), elements=60, t_end=0.5) -> list[str]:
+    """Markdown: the lumped benchmark pantograph at 320 km/h on the interaction path and on the
+    shared multibody path (catenary scene + generalized-alpha), wall per simulated second and
+    contact-force statistics, for lines of ``spans`` spans (one run each)."""
+    rows = []
+    for n in spans:
+        out = compare(n_spans=n, elements=elements, t_end=t_end)
+        rows.append((n, out["n_dofs_ip"], out["n_q_mb"], out["wall_ip_s"] / t_end, out["wall_mb_alpha_s"] / t_end,
+                     out["wall_mb_build_eq_s"], out["mean_ip_N"], out["mean_mb_N"], out["std_ip_N"], out["std_mb_N"],
+                     out["rms_diff_N"], out["mb_stats"]["newton_iterations"] / out["mb_stats"]["steps"]))
+        print(f"  {n} spans done", flush=True)
+    base_ip, base_mb = rows[0][3], rows[0][4]
+    return [
+        "## A line passage on the shared multibody path",
+        "",
+        f"benchmark2015 catenary, {elements} elements/span, lumped pantograph at 320 km/h, penalty contact, dt = 1 ms, "
+        f"rho_inf = 0.8, {t_end:g} s from the static equilibrium. *interaction*: `run_passage` (CoupledLine, tol 1e-4 m). "
+        "*scene*: `catenary_scene` + `add_lumped_pantograph` + `solve_equilibrium` + `generalized_alpha` (tol 1e-4 m as the interaction path, "
+        "the integrator's multipliers). Wall per simulated second of the integration (the scene's includes its "
+        "start and post-processing); set-up = scene, model and static equilibrium. One run each: compare ratios.",
+        "",
+        "| spans | unknowns (interaction / scene) | interaction [s/s] | scene [s/s] | scene / interaction | "
+        "scene / its 10-span | set-up [s] | mean [N] (int. / scene) | std [N] (int. / scene) | rms diff [N] | "
+        "Newton it./step |",
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        *[f"| {n} | {a} / {b} | {w_ip:.2f} | {w_mb:.2f} | {w_mb / w_ip:.1f} | {w_mb / base_mb:.1f} | {su:.1f} | "
+          f"{m1:.2f} / {m2:.2f} | {s1:.2f} / {s2:.2f} | {rms:.3f} | {it:.2f} |"
+          for n, a, b, w_ip, w_mb, su, m1, m2, s1, s2, rms, it in rows],
+        "",
+        f"Interaction path: its own 10-span figure {base_ip:.2f} s/s.",
+        "",
+    ]
 
 
 def main(argv):

@@ -30,6 +30,7 @@ import scipy.linalg as sla
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
+from ..assembly.banded import BandedCholesky
 from ..codegen.library import BufferedFunction, symbolic_kernels
 from ..dae.formulation import Formulation
 from ..errors import SolverError
@@ -73,6 +74,7 @@ class Bulk:
         self.bh2 = None
         self.factorizations = 0
         self._columns: dict[int, np.ndarray] = {}
+        self._permutation = None
         q_f = ca.MX.sym("q", form.n_f)
         mass_rest = ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(form.q_fixed + ca.mtimes(form.P, q_f), "rest"),
                                                   form.P))
@@ -123,7 +125,14 @@ class Bulk:
             return
         a = self.jacobian.sparse(y[: self.n_b], p, shift[: self.n_b])[0]
         try:
-            self.lu = spla.splu(a.tocsc())
+            asymmetry = abs(a - a.T).max() if a.nnz else 0.0
+            if asymmetry <= 1e-12 * abs(a).max():
+                # A catenary's matrix is a narrow band after reordering: a banded Cholesky solves
+                # several times faster than SuperLU's LU (which it falls back to when not SPD)
+                self.lu = BandedCholesky(a, self._permutation)
+                self._permutation = self.lu.permutation  # same pattern at every refactorization
+            else:
+                self.lu = spla.splu(a.tocsc())
         except RuntimeError:
             raise SolverError("generalized-alpha: singular iteration matrix of the wires (an ANCF coordinate "
                               "without mass or stiffness?)") from None
@@ -164,7 +173,7 @@ class StepEquations:
     ``b = (alpha_m a_n - alpha_f v_dot_n) / (1 - alpha_f)``."""
 
     def __init__(self, form: Formulation, variant: str, expand: bool = False, bulk: Bulk | None = None,
-                 mass_scale: float | None = None):
+                 mass_scale: float | None = None, proxies: bool = True):
         n_f, n_s, n_c, n_sc = form.n_f, form.n_s, form.n_c, form.n_sc
         self.n_u, self.n_c, self.n_s, self.n_sc = n_f + n_s, n_c, n_s, n_sc
         n_u = self.n_u
@@ -173,33 +182,50 @@ class StepEquations:
         self.bulk = bulk if bulk is not None else Bulk(form, n_u, expand)
         y = ca.MX.sym("y", n_y)
         p = ca.MX.sym("p", 3 * n_u + 4)
-        # The rest depends on few unknowns: entered as a structurally sparse y, its graph and
-        # Jacobian never touch the other thousands.
-        pattern = ca.Function("alpha_rest", [y, p], [self._rows(y, p)[0]]).sparsity_jac(0, 0)
-        self.rest_columns = np.unique(np.array(pattern.get_col(), int))
-        k = self.rest_columns.size
-        y_rest = ca.MX.sym("y_rest", k)
-        y_sparse = ca.MX(ca.Sparsity.triplet(n_y, 1, self.rest_columns.tolist(), [0] * k), y_rest)
-        # Built on the kernels' SX forms and expanded: as scalar operations the rest's Jacobian
-        # evaluates some 30 times faster than through the MX graph.
-        with symbolic_kernels():
-            r_rest, shift = self._rows(y_sparse, p)
-            rest = ca.Function("alpha_rest", [y_rest, p], [ca.densify(r_rest), ca.densify(shift)])
+        self.proxies = _Proxies.choose(self, y, p) if proxies else None
+        model = form.model
+        saved = [sl.window for sl in model.windowed()]
+        w = ca.MX.sym("w", 0 if self.proxies is None else 2 * len(self.proxies.items))
+        try:
+            if self.proxies is not None:
+                self.proxies.install(w)
+            # The rest depends on few unknowns: entered as a structurally sparse y, its graph and
+            # Jacobian never touch the other thousands.
+            pattern = ca.Function("alpha_rest", [y, p, w], [self._rows(y, p)[0]]).sparsity_jac(0, 0)
+            self.rest_columns = np.unique(np.array(pattern.get_col(), int))
+            k = self.rest_columns.size
+            y_rest = ca.MX.sym("y_rest", k)
+            y_sparse = ca.MX(ca.Sparsity.triplet(n_y, 1, self.rest_columns.tolist(), [0] * k), y_rest)
+            # Built on the kernels' SX forms and expanded: as scalar operations the rest's
+            # Jacobian evaluates some 30 times faster than through the MX graph.
+            with symbolic_kernels():
+                rest = ca.Function("alpha_rest", [y_rest, p, w], list(self._rows(y_sparse, p, contacts=True)))
+        finally:
+            model.element_override.clear()
+            for sl, window in zip(model.windowed(), saved):
+                sl.window = window
         try:
             rest = rest.expand()
-            y_rest, p = rest.sx_in()
+            y_rest, p, w = rest.sx_in()
         except RuntimeError:  # a kernel without an SX form: the MX graph
-            y_rest, p = rest.mx_in()
-        r_rest, shift = rest(y_rest, p)
+            y_rest, p, w = rest.mx_in()
+        r_rest = rest(y_rest, p, w)[0]
         self._rest = BufferedFunction(rest)
-        self._rest_jacobian = BufferedFunction(ca.Function("alpha_rest_jacobian", [y_rest, p],
-                                                           [ca.jacobian(r_rest, y_rest)]))
+        # the outputs are sparse (most rows belong to the bulk): their nonzeros' places
+        self._r_rows = np.array(rest.sparsity_out(0).row(), int)
+        self._shift_rows = np.array(rest.sparsity_out(1).row(), int)
+        jac = ca.Function("alpha_rest_jacobian", [y_rest, p, w], [ca.jacobian(r_rest, y_rest)])
+        self._rest_jacobian = BufferedFunction(jac)
+        colind, row = jac.sparsity_out(0).get_ccs()
+        self._jac_rows = np.array(row, int)
+        self._jac_cols = self.rest_columns[np.repeat(np.arange(k), np.diff(colind))]
         self.mass_scale = mass_scale  # kg: mean diagonal of M, converts multiplier updates to positions
         self._coupling = None
 
-    def _rows(self, y, p):
+    def _rows(self, y, p, contacts: bool = False):
         """The rest's scaled residual rows and the stabilization's shift ``G^T nu`` at ``(y,
-        p)``: the step residual without the bulk's mass and forces."""
+        p)``: the step residual without the bulk's mass and forces (with ``contacts``, also the
+        penalty contacts' gaps and normal forces)."""
         form, variant = self.form, self.variant
         n_f, n_s, n_c, n_sc, n_u, n_y = form.n_f, self.n_s, self.n_c, self.n_sc, self.n_u, self.n_y
         u_pred, v_pred, b, t, bh2, gh, cm = _data(p, n_u)
@@ -221,6 +247,8 @@ class StepEquations:
         if variant == "stabilized":
             rows.append(bh2 / gh * (ca.mtimes(k["Cq"], v[:n_f]) + ca.mtimes(k["Cs"], v[n_f:]) + k["Ct"]))
         rows.append(k["T"])
+        if contacts:
+            return ca.vertcat(*rows), shift, k["gap"], k["fc"]
         return ca.vertcat(*rows), shift
 
     @staticmethod
@@ -231,8 +259,24 @@ class StepEquations:
         return k
 
     # --- evaluation ---------------------------------------------------------------------------
+    def _inputs(self, y, p):
+        """The rest's inputs at ``(y, p)`` and the proxies' maps (None without proxies)."""
+        if self.proxies is None:
+            return y[self.rest_columns], p, np.zeros(0), None
+        y2, p2, w, maps = self.proxies.substitute(y, p)
+        return y2[self.rest_columns], p2, w, maps
+
     def _rest_values(self, y, p):
-        return self._rest.nonzeros(y[self.rest_columns], p)
+        """The rest's residual (n_y) and shift (n_u) at ``(y, p)``, dense."""
+        y_rest, p_in, w, maps = self._inputs(y, p)
+        r_nz, shift_nz, *_ = self._rest.nonzeros(y_rest, p_in, w)
+        r, shift = np.zeros(self.n_y), np.zeros(self.n_u)
+        r[self._r_rows] = r_nz
+        shift[self._shift_rows] = shift_nz
+        if maps is not None:
+            _move_back(r, maps)
+            _move_back(shift, maps)
+        return r, shift
 
     def residual(self, y, p) -> np.ndarray:
         r, shift = self._rest_values(y, p)
@@ -240,6 +284,20 @@ class StepEquations:
         if n_b:
             r[:n_b] += self.bulk.residual.nonzeros(y[:n_b], p, shift[:n_b])[0]
         return r
+
+    def contacts(self, u, v, sc, t) -> tuple[np.ndarray, np.ndarray]:
+        """Gaps (m) and normal forces (N) of the penalty contacts at the state ``(u, v, sc)``
+        and time ``t``: the rest at ``y = [u, 0, sc]`` with step data for which ``v`` is the
+        velocity (``u_pred = u``, ``v_pred = v``)."""
+        n_u = self.n_u
+        y = np.zeros(self.n_y)
+        y[:n_u] = u
+        if self.n_sc:
+            y[self.n_y - self.n_sc :] = sc
+        p = np.r_[u, v, np.zeros(n_u), t, 1.0, 1.0, 1.0]
+        y_rest, p_in, w, _ = self._inputs(y, p)
+        _, _, gap, force = self._rest.nonzeros(y_rest, p_in, w)
+        return gap, force
 
     def update(self, y, p) -> tuple:
         """``a``, ``v`` and ``v_dot`` at the end of the step whose unknowns are ``y``."""
@@ -256,17 +314,27 @@ class StepEquations:
         """The rest's exact Jacobian as (rows, columns, values), nonzero values only, with the
         bulk rows' dependence on ``nu`` through the shift of ``a`` under the stabilized form:
         ``-(c_m M + gamma h C) G^T`` with the constant bulk mass and Rayleigh matrices."""
-        jac = self._rest_jacobian.sparse(y[self.rest_columns], p)[0].tocoo()
-        keep = jac.data != 0
-        rows, cols, data = jac.row[keep], self.rest_columns[jac.col[keep]], jac.data[keep]
+        y_rest, p_in, w, maps = self._inputs(y, p)
+        values = self._rest_jacobian.nonzeros(y_rest, p_in, w)[0]
+        keep = values != 0
+        rows, cols, data = self._jac_rows[keep], self._jac_cols[keep], values[keep]
+        if maps is not None:  # the proxies' rows and columns are those of the actual elements
+            to = np.arange(self.n_y)
+            for proxy, actual in maps:
+                to[proxy] = actual
+            rows, cols = to[rows], to[cols]
+            keep = (rows >= 0) & (cols >= 0)
+            rows, cols, data = rows[keep], cols[keep], data[keep]
         n_b, n_u, n_c = self.bulk.n_b, self.n_u, self.n_c
         if self.variant == "stabilized" and n_b:
             g = (rows >= n_u) & (rows < n_u + n_c) & (cols < n_b)  # G on the bulk coordinates
             if np.any(g):
-                _, _, _, _, bh2, gh, cm = _data(p, n_u)
-                g_b = sps.csc_matrix((data[g], (rows[g] - n_u, cols[g])), shape=(n_c, n_b))
-                extra = (-(cm * self.bulk.mass_matrix + gh * self.bulk.rayleigh) @ g_b.T).tocoo()
-                extra.eliminate_zeros()
+                _, _, _, _, _, gh, cm = _data(p, n_u)
+                g_cols, at = np.unique(cols[g], return_inverse=True)
+                g_b = np.zeros((g_cols.size, n_c))  # G^T on the bulk columns it touches
+                np.add.at(g_b, (at, rows[g] - n_u), data[g])
+                block = cm * self.bulk.mass_matrix[:, g_cols] + gh * self.bulk.rayleigh[:, g_cols]
+                extra = (-(block @ sps.csr_matrix(g_b))).tocoo()
                 rows = np.r_[rows, extra.row]
                 cols = np.r_[cols, n_u + n_c + extra.col]
                 data = np.r_[data, extra.data]
@@ -333,6 +401,118 @@ class StepEquations:
         x[:n_b] -= z_bulk @ w[:n_t]
         x[n_b:] -= w[n_t:]
         return x
+
+
+class _Proxies:
+    """Stand-in elements for the element windows of sliding joints and penalty contacts.
+
+    A window of many elements makes the rest's Jacobian structurally dense over all of them
+    (the element is chosen by masks of ``s``) and must be rebuilt whenever the point nears its
+    edge: on a line, several times per simulated second at a fraction of a second each. Instead
+    the rest is built once with a one-element window on a *proxy* element of each wire
+    (interior, all coordinates free, touched by nothing else of the rest, proxies two elements
+    apart) whose start and length are inputs; each evaluation writes the actual element's
+    coordinates and step data into the proxy's places, and the results at the proxy's rows and
+    columns are moved back to the actual element's (dropping fixed coordinates)."""
+
+    def __init__(self, step, items, elements):
+        form = step.form
+        model = form.model
+        y_of_q = np.full(model.n_q, -1)
+        y_of_q[model.free] = np.arange(form.n_f)
+        q_fixed = np.array(form.q_fixed).ravel()
+        n_sliding = len(model.sliding)
+        self.n_u = step.n_u
+        self._model = model
+        self.items = []
+        for i, (sl, j) in enumerate(zip(items, elements)):
+            where = form.n_f + i if i < n_sliding else step.n_y - step.n_sc + (i - n_sliding)
+            self.items.append((sl, j, y_of_q[sl.element_indices], q_fixed[sl.element_indices], where))
+
+    @classmethod
+    def choose(cls, step, y, p):
+        """Proxies for ``step``'s model, or None when its windows never move or no element
+        qualifies (the windows are then rebuilt as the points move)."""
+        model = step.form.model
+        items = model.windowed()
+        if not items or not model.windows_move():
+            return None
+        y_of_q = np.full(model.n_q, -1)
+        y_of_q[model.free] = np.arange(step.form.n_f)
+
+        def candidates(offset):
+            picked, used = [], set()
+            for sl in items:
+                n_el = len(sl.element_start) - 1
+                ok = [j for j in range(1 + offset, n_el - 1) if np.all(y_of_q[sl.element_indices[j]] >= 0)
+                      and not used & set(sl.element_indices[max(j - 1, 0) : j + 2].ravel().tolist())]
+                if not ok:
+                    return None
+                picked.append(ok[0])
+                used |= set(sl.element_indices[ok[0]].tolist())
+            return picked
+
+        first, second = candidates(0), candidates(3)
+        if first is None or second is None:
+            return None
+        # Bulk columns of the rest that belong to no proxy: other rest terms on the wires.
+        others = set()
+        for elements in (first, second):
+            proxy = cls(step, items, elements)
+            w = ca.MX.sym("w", 2 * len(items))
+            saved = [sl.window for sl in items]
+            try:
+                proxy.install(w)
+                pattern = ca.Function("probe", [y, p, w], [step._rows(y, p)[0]]).sparsity_jac(0, 0)
+            finally:
+                model.element_override.clear()
+                for sl, window in zip(items, saved):
+                    sl.window = window
+            cols = set(np.array(pattern.get_col(), int).tolist())
+            mine = set(y_of_q[np.concatenate([sl.element_indices[j] for sl, j in zip(items, elements)])].tolist())
+            others |= {c for c in cols - mine if c < step.bulk.n_b}
+        proxy = cls(step, items, first)
+        if others & set(y_of_q[np.concatenate([sl.element_indices[j] for sl, j in zip(items, first)])].tolist()):
+            return None
+        return proxy
+
+    def install(self, w) -> None:
+        """One-element windows on the proxies, their start and length the symbols ``w``."""
+        for i, (sl, j, *_) in enumerate(self.items):
+            sl.window = (j, j + 1)
+            self._model.element_override[id(sl)] = (w[2 * i], w[2 * i + 1])
+
+    def substitute(self, y, p):
+        """``(y, p)`` with each proxy's places holding its actual element's values, the
+        elements' start and length ``w``, and the maps ``(proxy, actual)`` of y indices."""
+        n_u = self.n_u
+        y2, p2 = y.copy(), p.copy()
+        w = np.empty(2 * len(self.items))
+        maps = []
+        for i, (sl, j, index, fixed, where) in enumerate(self.items):
+            n_el = len(sl.element_start) - 1
+            k = int(np.clip(np.searchsorted(sl.element_start, y[where], side="right") - 1, 0, n_el - 1))
+            proxy, actual = index[j], index[k]
+            free = actual >= 0
+            at = np.where(free, actual, 0)
+            y2[proxy] = np.where(free, y[at], fixed[k])
+            p2[proxy] = np.where(free, p[at], fixed[k])
+            p2[n_u + proxy] = np.where(free, p[n_u + at], 0.0)
+            p2[2 * n_u + proxy] = np.where(free, p[2 * n_u + at], 0.0)
+            w[2 * i] = sl.element_start[k]
+            w[2 * i + 1] = sl.element_start[k + 1] - sl.element_start[k]
+            maps.append((proxy, actual))
+        return y2, p2, w, maps
+
+
+def _move_back(vector: np.ndarray, maps) -> None:
+    """Add the proxies' entries of ``vector`` to their actual elements' (in place)."""
+    values = [vector[proxy].copy() for proxy, _ in maps]
+    for proxy, _ in maps:
+        vector[proxy] = 0.0
+    for (_, actual), v in zip(maps, values):
+        keep = actual >= 0
+        np.add.at(vector, actual[keep], v[keep])
 
 
 def _csc(matrix) -> sps.csc_matrix:

@@ -109,13 +109,40 @@ class AlphaRun:
     multipliers: np.ndarray
     stats: dict = field(default_factory=dict)
     walls: list = field(default_factory=list)
+    monitored: dict = field(default_factory=dict)
 
-    def result(self, wall0: float | None = None) -> SimulationResult:
-        """The :class:`SimulationResult` of these outputs (as :func:`simulate` returns it)."""
+    def result(self, wall0: float | None = None, multipliers: str = "kkt") -> SimulationResult:
+        """The :class:`SimulationResult` of these outputs (as :func:`simulate` returns it);
+        ``multipliers`` as for :func:`generalized_alpha`."""
         n = len(self.xs)
         wall0 = time.perf_counter() - self.stats.get("wall_s", 0.0) if wall0 is None else wall0
-        return collect_result(self.form, self.t_s[:n], self.xs, self.zs, self.stats, wall0, [()] * n, [],
-                              self.walls)
+        given = None
+        if multipliers == "integrator":
+            zb = self.form.blocks()[1]
+            given = (np.asarray(self.zs, float).reshape(n, -1)[:, zb["a"].slice], self.multipliers[:n])
+        res = collect_result(self.form, self.t_s[:n], self.xs, self.zs, self.stats, wall0, [()] * n, [],
+                             self.walls, given)
+        res.monitored = {key: np.asarray(values) for key, values in self.monitored.items()}
+        return res
+
+
+@dataclass
+class StepState:
+    """What a ``monitor`` of :func:`generalized_alpha` sees after each step (SI units): time
+    ``t_s``, all coordinates ``q``, velocities ``v`` and accelerations ``a`` (fixed ones
+    included, ``model.coordinate_names()``), the sliding-joint arc lengths ``s_m``, the
+    integrator's multipliers, and per penalty contact (``model.contacts``) the arc length
+    ``sc_m``, normal gap ``gap_m`` (> 0 separated) and normal force ``force_N``."""
+
+    t_s: float
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    s_m: np.ndarray
+    multipliers: np.ndarray
+    sc_m: np.ndarray
+    gap_m: np.ndarray
+    force_N: np.ndarray
 
 
 @dataclass
@@ -213,11 +240,22 @@ class _Integrator:
         self.stats["steps"] += 1
         self.stats["nsteps"] = self.stats["steps"]
         x, z = self.layout(new)
-        if update_windows(self.model, self.form, x, z):
+        if self.stepper.proxies is None and update_windows(self.model, self.form, x, z):
             # The element windows are part of the equations' graph: rebuild them.
             self.stepper = self._build(self.stepper)
             self.stats["rebuilds"] += 1
         return new
+
+    def step_state(self, s: _State, t: float) -> StepState:
+        """The :class:`StepState` of ``s`` at time ``t`` (physical, all coordinates)."""
+        model, form = self.model, self.form
+        n_f = form.n_f
+        q, v, a = model.q0.copy(), np.zeros(model.n_q), np.zeros(model.n_q)
+        q[model.free] = form.to_physical(s.u[:n_f])
+        v[model.free] = form.to_physical(s.v[:n_f])
+        a[model.free] = form.to_physical(s.v_dot[:n_f])
+        gap, force = self.stepper.contacts(s.u, s.v, s.sc, t)
+        return StepState(t, q, v, a, s.u[n_f:].copy(), s.lam.copy(), s.sc.copy(), gap, force)
 
     def layout(self, s: _State):
         """The state in the augmented index-1 layout ``x = [q, s, v, w]``, ``z = [a, s_dd, lambda(, sc)]``."""
@@ -295,7 +333,7 @@ class _Integrator:
 
 def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: float = 0.9,
                     variant: str = "stabilized", tol: float = 1e-10, max_iterations: int = 20, n_out: int = 200,
-                    progress: bool = True, expand: bool = False, max_halvings: int = 4) -> AlphaRun:
+                    progress: bool = True, expand: bool = False, max_halvings: int = 4, monitor=None) -> AlphaRun:
     """Integrate ``model`` from its consistent initial state to ``t_end`` with fixed steps.
 
     Parameters are those of :func:`generalized_alpha`.
@@ -342,6 +380,16 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
     integ = _Integrator(model, form, coef, variant, tol, int(max_iterations), max_halvings, expand, stats)
     state = integ.start(x, z, h)
     run.multipliers[0] = state.lam
+
+    def record(t):
+        if monitor is None:
+            return
+        values = monitor(integ.step_state(state, t))
+        run.monitored.setdefault("t_s", []).append(t)
+        for key, value in values.items():
+            run.monitored.setdefault(key, []).append(value)
+
+    record(0.0)
     bar = Progress("generalized-alpha", t_end, "s", enabled=progress)
     step = 0
     try:
@@ -359,6 +407,7 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
                                           f"(dt = {h:.3g} s) even with a fresh Jacobian, {tried}; try a smaller dt "
                                           "or a smaller rho_inf") from None
                     step += 1
+                    record(step * h)
                 x, z = integ.layout(state)
                 run.xs.append(x)
                 run.zs.append(z)
@@ -383,7 +432,8 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
 
 def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: float = 0.9,
                       variant: str = "stabilized", tol: float = 1e-10, max_iterations: int = 20, n_out: int = 200,
-                      progress: bool = True, expand: bool = False, max_halvings: int = 4) -> SimulationResult:
+                      progress: bool = True, expand: bool = False, max_halvings: int = 4,
+                      multipliers: str = "kkt", monitor=None) -> SimulationResult:
     """Simulate ``model`` from 0 to ``t_end`` seconds by the generalized-alpha method (fixed step).
 
     Parameters
@@ -420,9 +470,19 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
     progress : bool
         Progress bar on long runs.
     expand : bool
-        Expand the step's functions to scalar operations (CasADi SX): about 15 % less time per
-        step on a 16-element wire, but a second or more to build per element window; pays off
-        on runs of several thousand steps whose windows do not move.
+        Expand the bulk's functions (the wires) to scalar operations (CasADi SX) when their
+        kernels allow it (the rest's always are): slow to build on a line, rarely worth it.
+    multipliers : {"kkt", "integrator"}
+        Multipliers and accelerations of the result: ``"kkt"`` solves the KKT system at each
+        output (as for IDAS; exact for the state, a sparse factorization of the mass matrix per
+        output); ``"integrator"`` keeps the integrator's own ``lambda_{n+1}`` and ``v_dot_{n+1}``
+        (order 2 under the stabilized variant, an O(h) start-up transient under index3):
+        for long runs with many outputs, whose post-processing the KKT solves dominate.
+    monitor : callable, optional
+        ``monitor(StepState) -> dict`` called at the start and after every step; the values are
+        stacked over the steps in ``result.monitored`` (with ``t_s``). What a passage records at
+        every step (a contact force, a few heights) without a full output per step, whose
+        post-processing (energies, every contact over the whole wire) costs more than the step.
 
     Returns
     -------
@@ -440,11 +500,17 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
         (the message names the step and the last size tried); ``partial`` holds the result so far.
     """
     wall0 = time.perf_counter()
+    if multipliers not in ("kkt", "integrator"):
+        raise ParameterError(f"multipliers={multipliers!r}: must be 'kkt' or 'integrator'")
+    # The per-step solves are small: BLAS threads only contend (10x slower on a busy 2-core machine).
+    from threadpoolctl import threadpool_limits
+
     try:
-        run = integrate_alpha(model, t_end, dt, rho_inf, variant, tol, max_iterations, n_out, progress, expand,
-                              max_halvings)
+        with threadpool_limits(limits=1, user_api="blas"):
+            run = integrate_alpha(model, t_end, dt, rho_inf, variant, tol, max_iterations, n_out, progress, expand,
+                                  max_halvings, monitor)
     except SolverError as err:
         if isinstance(err.partial, AlphaRun):
-            err.partial = err.partial.result(wall0)
+            err.partial = err.partial.result(wall0, multipliers)
         raise
-    return run.result(wall0)
+    return run.result(wall0, multipliers)

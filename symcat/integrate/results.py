@@ -58,6 +58,9 @@ class SimulationResult:
         normal gap ``gap_m`` (> 0 separated; the constraint drift while in contact), ``open``
         (bool: lifted off, see :mod:`symcat.wheelrail_events.contact_switching`) and the times
         (s) of its lift-offs and touchdowns, ``lift_off_s`` and ``touchdown_s``.
+    monitored : dict
+        Generalized-alpha's per-step records (its ``monitor``): ``t_s`` (n_steps + 1,) and the
+        monitor's keys stacked over the steps; empty otherwise.
     """
 
     t_s: np.ndarray
@@ -77,6 +80,7 @@ class SimulationResult:
     output_wall_s: np.ndarray | None = None
     contacts: dict = field(default_factory=dict)
     wheelrail: dict = field(default_factory=dict)
+    monitored: dict = field(default_factory=dict)
 
     def coordinate(self, name: str) -> np.ndarray:
         """History of one coordinate, e.g. ``"wire[3].z"`` or ``"body.x"``."""
@@ -97,14 +101,21 @@ class SimulationResult:
         np.savez_compressed(path, **arrays)
 
 
-def collect_result(form: Formulation, t, xs, zs, stats, wall0, opens, events, walls=None) -> SimulationResult:
+def collect_result(form: Formulation, t, xs, zs, stats, wall0, opens, events, walls=None,
+                   given=None) -> SimulationResult:
+    """The :class:`SimulationResult` of the outputs ``xs``, ``zs`` at times ``t``.
+
+    ``given = (accelerations, multipliers)`` (free internal coordinates, (n, n_f) and (n, n_c)):
+    the integrator's own, used instead of solving the KKT system at each output (which costs a
+    sparse factorization of the mass matrix per output: most of the post-processing of a long
+    run on a line)."""
     model = form.model
     # Post-processing sees the whole wire: the integration windows have moved on.
     saved = [sl.window for sl in model.windowed()]
     for sl in model.windowed():
         sl.window = (0, len(sl.element_start) - 1)
     try:
-        res = _collect(form, t, xs, zs, stats, wall0, opens, events)
+        res = _collect(form, t, xs, zs, stats, wall0, opens, events, given)
         if walls is not None:
             res.output_wall_s = np.asarray(walls[: len(res.t_s)], float)
         return res
@@ -117,12 +128,12 @@ def collect_result(form: Formulation, t, xs, zs, stats, wall0, opens, events, wa
 CHUNK = 256
 
 
-def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events) -> SimulationResult:
+def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events, given=None) -> SimulationResult:
     model = form.model
     state = _stacked_state(form, xs, zs)
     n_t = state["q"].shape[0]
     q, v = _physical(form, state["q"], model.q0), _physical(form, state["v"], np.zeros(model.n_q))
-    post = _PostTerms(form)
+    post = _PostTerms(form, light=given is not None)
     n_w = len(model.wheelrail)
     gaps, contact_forces = np.zeros((n_t, form.n_sc)), np.zeros((n_t, form.n_sc))
     acc = np.zeros_like(q)
@@ -144,7 +155,9 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events) -> Simul
         closed = _closed_mask(model.n_c, open_rows[rows])
         pos[rows], vel[rows] = _max_abs(terms["C"], closed), _max_abs(terms["C_dot"], closed)
         wheel_gap[rows] = _wheel_gaps(model, q[rows], chunk["s"], terms["C"])
-        if model.n_c:
+        if given is not None:
+            a, lam[rows] = given[0][rows], given[1][rows]
+        elif model.n_c:
             # Multipliers from the KKT system at each output (exact for the state, whatever
             # IDAS's tolerance on algebraic variables): the same for every formulation.
             a, lam[rows], creep_record[rows] = post.multipliers(chunk, terms, open_rows[rows])
@@ -250,12 +263,12 @@ class _PostTerms:
     creep records and joint reactions. The sparsity patterns are the same at every output, so
     the KKT matrices and reactions are assembled by index maps built once."""
 
-    def __init__(self, form: Formulation):
+    def __init__(self, form: Formulation, light: bool = False):
         from ..assembly.wheelrail import has_creep
 
         self.form = form
         model = form.model
-        fn, self.patterns = _terms_function(form)
+        fn, self.patterns = _terms_function(form, light)
         self._terms, self._names = _Mapped(fn), fn.name_out()
         self.creep = _Mapped(form.creep_function()) if has_creep(model) else None
         self._normal = _Mapped(form.normal_direction_function()) if model.wheelrail else None
@@ -313,10 +326,12 @@ class _PostTerms:
                 for m_nz, f in zip(terms["M"], terms["Q"])]
 
 
-def _terms_function(form: Formulation) -> tuple[ca.Function, dict]:
+def _terms_function(form: Formulation, light: bool = False) -> tuple[ca.Function, dict]:
     """One output's terms as a function of ``(q, v, s, w, t, sc)``: ``C``, its rate ``C_dot``,
     ``s_dot``, the nonzeros of ``Cq``, ``Cs`` and ``M``, ``Q``, ``Qd``, contact ``gap`` and ``fc``,
-    ``kinetic`` and ``potential`` energy; and the patterns of the sparse matrices."""
+    ``kinetic`` and ``potential`` energy; and the patterns of the sparse matrices. ``light``:
+    without ``M``, ``Q`` and ``Qd`` (the KKT system's, not solved when the integrator's
+    multipliers are given)."""
     model = form.model
     n_f, n_s = form.n_f, form.n_s
     qs, vs = ca.MX.sym("q", n_f), ca.MX.sym("v", n_f)
@@ -329,9 +344,10 @@ def _terms_function(form: Formulation) -> tuple[ca.Function, dict]:
     kk = form.terms(qs, vs, ss, s_dot, ts, scs)
     qf = form.q_fixed + ca.mtimes(form.P, qs)
     vf = ca.mtimes(form.P, vs)
-    sparse = {"Cq": kk["Cq"], "Cs": kk["Cs"], "M": kk["M"]}
+    sparse = {"Cq": kk["Cq"], "Cs": kk["Cs"]} if light else {"Cq": kk["Cq"], "Cs": kk["Cs"], "M": kk["M"]}
+    kkt = {} if light else {"Q": kk["Q"], "Qd": kk["Qd"]}
     outs = {"C": kk["C"], "C_dot": ca.mtimes(kk["Cq"], vs) + ca.mtimes(kk["Cs"], s_dot) + kk["Ct"], "s_dot": s_dot,
-            **{name: ca.vec(x.nz[:]) for name, x in sparse.items()}, "Q": kk["Q"], "Qd": kk["Qd"], "gap": kk["gap"],
+            **{name: ca.vec(x.nz[:]) for name, x in sparse.items()}, **kkt, "gap": kk["gap"],
             "fc": kk["fc"], "kinetic": model.kinetic_energy(qf, vf), "potential": model.potential_energy(qf)}
     fn = ca.Function("post", [qs, vs, ss, ws, ts, scs], list(outs.values()),
                      ["q", "v", "s", "w", "t", "sc"], list(outs))

@@ -22,7 +22,7 @@ from ..errors import ParameterError, SolverError
 from ..integrate.alpha_coefficients import AlphaCoefficients
 from ..progress import Progress
 from ..run_control import check_interrupt, ended_early, integrating
-from .banded import BandedCholesky
+from ..assembly.banded import BandedCholesky
 from .coupled import CoupledLine
 from .recorder import PassageRecorder
 

@@ -342,12 +342,37 @@ def trim_uplift(form, pantograph: ScenePantograph, target_force: float, wire: st
                       f"{target_force:g} N in {max_solves} static solves (last {f0:g} N at {u0:g} N uplift)")
 
 
+def _monitor(form, model, element):
+    """Per-step records of a penalty contact's passage (generalized-alpha's ``monitor``): what
+    the statistics need at every step, without a full output per step."""
+    st = form.structure
+    head = model.rigid_offset[element.body]
+    k = [ct.joint.name for ct in model.contacts].index(element.name)
+    supports = st.cw_xyz[st.support_nodes, 2]
+
+    def monitor(s):
+        return {"x_contact_m": s.q[head], "contact_force_N": s.force_N[k], "penetration_m": -s.gap_m[k],
+                "panhead_z_m": s.q[head + 2], "panhead_acc_m_s2": s.a[head + 2], "support_z_m": s.q[supports],
+                "dropper_tension_N": st.dropper_state(s.q[: st.n])[2]}
+
+    return monitor
+
+
 def _record(res, form, model, element, snapshot_every: float) -> dict:
-    """The SceneRecord arrays of a SimulationResult."""
+    """The SceneRecord arrays of a SimulationResult (per-step values from its ``monitored``
+    records when there are, snapshots from its outputs)."""
     from ..scene import PenaltyContact
 
     st = form.structure
     q = np.asarray(res.q)
+    if res.monitored:
+        m = res.monitored
+        snap = _snapshots(np.asarray(res.t_s), snapshot_every)
+        return {"t_s": m["t_s"], **{key: m[key][:, None] for key in ("x_contact_m", "contact_force_N", "penetration_m",
+                                                                      "panhead_z_m", "panhead_acc_m_s2")},
+                "contact_force_wire_N": m["contact_force_N"][:, None, None], "support_z_m": m["support_z_m"],
+                "dropper_tension_N": m["dropper_tension_N"], "snapshot_t_s": np.asarray(res.t_s)[snap],
+                "snapshot_q": q[snap, : st.n]}
     head = model.rigid_offset[element.body]
     if isinstance(element, PenaltyContact):
         c = res.contacts[element.name]
@@ -356,10 +381,7 @@ def _record(res, form, model, element, snapshot_every: float) -> dict:
         force = -np.asarray(res.reactions_N[element.name])[:, 2]
         penetration = np.asarray(res.position_drift)
     t = np.asarray(res.t_s)
-    snap = [0]
-    for k in range(1, len(t)):
-        if t[k] >= t[snap[-1]] + snapshot_every - 1e-12:
-            snap.append(k)
+    snap = _snapshots(t, snapshot_every)
     q_cat = q[:, : st.n]
     return {
         "t_s": t,
@@ -374,6 +396,15 @@ def _record(res, form, model, element, snapshot_every: float) -> dict:
         "snapshot_t_s": t[snap],
         "snapshot_q": q_cat[snap],
     }
+
+
+def _snapshots(t: np.ndarray, every: float) -> list[int]:
+    """Indices of the outputs at least ``every`` seconds apart, from the first."""
+    snap = [0]
+    for k in range(1, len(t)):
+        if t[k] >= t[snap[-1]] + every - 1e-12:
+            snap.append(k)
+    return snap
 
 
 def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed: float, target_force: float,
@@ -445,7 +476,16 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
         out.wall_s = time.perf_counter() - t0
         return out
     n_steps = math.ceil(duration / dt - 1e-9)
-    res = generalized_alpha(model, duration, dt, rho_inf, n_out=n_steps, tol=tol, progress=progress)
+    from ..scene import PenaltyContact
+
+    # A penalty contact's passage is recorded at every step by a monitor, with full outputs only
+    # for the snapshots; a sliding joint's force comes from the outputs' joint reactions.
+    monitor = _monitor(form, model, el) if isinstance(el, PenaltyContact) else None
+    # Snapshots every `per` steps, `per` a divisor of the steps: the step stays dt exactly.
+    per = max(d for d in range(1, max(1, round(record_every / dt)) + 1) if n_steps % d == 0)
+    n_out = n_steps if monitor is None else n_steps // per
+    res = generalized_alpha(model, duration, dt, rho_inf, n_out=n_out, tol=tol, progress=progress,
+                            multipliers="integrator", monitor=monitor)  # no KKT solve per output
     rec = SceneRecord(_record(res, form, model, el, record_every), form, speed, dict(res.stats))
     rec.uplift_N, rec.static_contact_force_N = uplift, f_static
     line._record = rec

@@ -263,3 +263,34 @@ def test_penalty_contact_is_lost_and_regained_as_on_idas():
     assert (c_ref["gap_m"] > 0).mean() > 0.1
     assert np.abs(res.q[:, off] - ref.q[:, off]).max() < 0.005 * np.ptp(ref.q[:, off])
     assert np.all(c["force_N"] >= 0) and np.all(c["force_N"][c["gap_m"] > 0] == 0)
+
+
+def test_the_integrators_own_multipliers_skip_the_kkt_post_processing():
+    """``multipliers="integrator"``: the result's multipliers and accelerations are the
+    integrator's own (the AlphaRun's), positions and velocities unchanged; under the stabilized
+    variant (order 2 in the multipliers) they agree with the KKT system of the output states
+    to the method's error."""
+    kkt = generalized_alpha(pendulum(), 0.5, 0.005, n_out=10, progress=False)
+    own = generalized_alpha(pendulum(), 0.5, 0.005, n_out=10, progress=False, multipliers="integrator")
+    np.testing.assert_array_equal(own.q, kkt.q)
+    np.testing.assert_array_equal(own.v, kkt.v)
+    assert not np.array_equal(own.multipliers, kkt.multipliers)
+    scale = np.abs(kkt.multipliers).max()
+    assert np.abs(own.multipliers - kkt.multipliers).max() < 1e-3 * scale
+    assert np.abs(own.a - kkt.a).max() < 1e-3 * np.abs(kkt.a).max()
+    with pytest.raises(ParameterError, match="multipliers='own': must be 'kkt' or 'integrator'"):
+        generalized_alpha(pendulum(), 0.5, 0.005, progress=False, multipliers="own")
+
+
+def test_a_monitor_sees_every_step():
+    """``monitor`` is called at the start and after every step; its values, stacked, match the
+    outputs at the output times, and the penalty contact's force matches the result's."""
+    model = head_under_wire(shake=30.0)[0]
+    seen = generalized_alpha(model, 0.05, 1e-3, n_out=5, progress=False, multipliers="integrator",
+                             monitor=lambda s: {"q": s.q, "force_N": s.force_N, "gap_m": s.gap_m})
+    m = seen.monitored
+    assert m["t_s"].shape == (51,) and np.allclose(m["t_s"], np.linspace(0, 0.05, 51))
+    every = np.arange(0, 51, 10)
+    np.testing.assert_allclose(m["q"][every], seen.q, atol=1e-12)
+    name = next(iter(seen.contacts))
+    np.testing.assert_allclose(m["force_N"][every, 0], seen.contacts[name]["force_N"], rtol=1e-9, atol=1e-9)
