@@ -62,3 +62,32 @@ def test_split_jacobian_and_woodbury_solve(line, variant):
     rhs = rng.normal(size=st.n_y)
     exact = spla.spsolve(st.jacobian(y, p).tocsc(), rhs)
     assert np.abs(st.solve(rhs) - exact).max() < 1e-8 * np.abs(exact).max()
+
+
+def test_proxy_element_equals_the_window(line):
+    """The rest built once on a stand-in element gives the residual, update and Jacobian of the
+    rest built on the element window around the contact (to round-off), with the contact on
+    another element than the proxy."""
+    form = Formulation(line, "augmented", "1")
+    proxied, windowed = StepEquations(form, "stabilized"), StepEquations(form, "stabilized", proxies=False)
+    assert proxied.proxies is not None and windowed.proxies is None
+    (sl, j, *_), = proxied.proxies.items
+    n_u = proxied.n_u
+    c, h = AlphaCoefficients(0.8), 1e-3
+    u0 = np.r_[line.q0[line.free], line.s0]
+    rng = np.random.default_rng(5)
+    p = np.r_[u0, rng.normal(0, 1e-2, n_u), rng.normal(0, 1.0, n_u), 0.0, c.beta * h * h, c.gamma * h,
+              (1 - c.alpha_m) / (1 - c.alpha_f)]
+    y = np.zeros(proxied.n_y)
+    y[:n_u] = u0 + rng.normal(0, 1e-5, n_u)
+    y[n_u : n_u + proxied.n_c] = rng.normal(0, 1e-5, proxied.n_c)
+    if proxied.n_sc:
+        y[-proxied.n_sc :] = line.sc0
+    s = y[proxied.proxies.items[0][-1]]
+    assert not sl.element_start[j] <= s < sl.element_start[j + 1]  # the contact is elsewhere
+    scale = np.abs(windowed.residual(y, p)).max()
+    np.testing.assert_allclose(proxied.residual(y, p), windowed.residual(y, p), atol=1e-12 * scale)
+    for a, b in zip(proxied.update(y, p), windowed.update(y, p)):
+        np.testing.assert_allclose(a, b, atol=1e-12 * max(1.0, np.abs(b).max()))
+    ja, jb = proxied.jacobian(y, p), windowed.jacobian(y, p)
+    assert abs(ja - jb).max() < 1e-10 * abs(jb).max()
