@@ -95,11 +95,12 @@ def run(p: dict):
                              aero_coefficient=p["aero_coefficient_N_s2_m2"], name=base.name, sources=base.sources)
     if p["pantograph"] != "lumped":  # a multibody pantograph with the lumped one's static contact force
         check_scene_pantograph(p, design.stagger, p["n_pantographs"], design.n_sections,
+                               {} if p["pantograph"] == "lumped_scene" else
                                {"pantograph_damping_N_s_m": (p["pantograph_damping_N_s_m"], "0,0,0")})
         extra = {"speed_kmh": p["speed_kmh"], "n_spans": design.line_spans, "tension_sections": design.n_sections,
                  "wave_speed_kmh": design.wave_speed * 3.6}
         return run_scene_pantograph(design, p, speed, float(panto.static_force(speed).sum()), "benchmark2015", extra,
-                                    aero_force=float(panto.aero_coefficient * speed**2))
+                                    aero_force=float(panto.aero_coefficient * speed**2), lumped=panto)
     result = run_passage(design, [panto] * p["n_pantographs"], speed, spacing=p["spacing_m"], **numerical_options(p))
     extra = {"speed_kmh": p["speed_kmh"], "uplift_N": uplift, "n_spans": design.line_spans,
              "tension_sections": design.n_sections,

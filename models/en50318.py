@@ -62,7 +62,8 @@ def run(p: dict):
         check_scene_pantograph(p, design.stagger)
         extra = {"speed_kmh": p["speed_kmh"], "static_force_N": p["static_force_N"],
                  "wave_speed_kmh": design.wave_speed * 3.6, "choices": design.sources}
-        return run_scene_pantograph(design, p, speed, p["static_force_N"], "en50318", extra)
+        return run_scene_pantograph(design, p, speed, p["static_force_N"], "en50318", extra,
+                                    lumped=en50318_pantograph(p["static_force_N"]))
     panto = en50318_pantograph(p["static_force_N"])
     result = run_passage(design, [panto], speed, **numerical_options(p))
     extra = {"speed_kmh": p["speed_kmh"], "static_force_N": p["static_force_N"],

@@ -104,11 +104,12 @@ def passage_output(result: PassageResult, p: dict, stem: str, extra: dict | None
 
 
 #: The pantograph model of a line-scale passage (benchmark2015, en50318).
-PANTOGRAPH_CHOICES = ("lumped", "seo2005")
+PANTOGRAPH_CHOICES = ("lumped", "lumped_scene", "seo2005")
 PANTOGRAPH_PARAMETER = Parameter(
     "pantograph", "lumped", "", "pantograph model: lumped (the model's lumped-mass pantograph on the interaction "
-    "path) or seo2005 (the seed paper's four-body pantograph as scene bodies on the multibody path, one pantograph, "
-    "one tension section; its uplift is trimmed to the static contact force)", choices=PANTOGRAPH_CHOICES)
+    "path), lumped_scene (the same pantograph as scene bodies on the shared multibody path) or seo2005 (the seed "
+    "paper's four-body pantograph as scene bodies); on the multibody path one pantograph, one tension section, the "
+    "uplift trimmed to the static contact force", choices=PANTOGRAPH_CHOICES)
 
 
 def check_scene_pantograph(p: dict, stagger: float, n_pantographs: int = 1, tension_sections: int = 1,
@@ -150,19 +151,27 @@ def check_scene_pantograph(p: dict, stagger: float, n_pantographs: int = 1, tens
 
 
 def run_scene_pantograph(design, p: dict, speed: float, target_force: float, stem: str, extra: dict,
-                         aero_force: float = 0.0) -> ModelOutput:
+                         aero_force: float = 0.0, lumped=None) -> ModelOutput:
     """Run ``p["pantograph"]`` (a multibody pantograph) over ``design`` at ``speed`` (m/s) with
     the static contact force ``target_force`` (N) by
     :func:`~.scene_passage.run_scene_passage`, with the model's numerical and contact
-    parameters; summary and files as :func:`passage_output`, plus the trimmed uplift."""
-    from .scene_passage import run_scene_passage, seo2005_fragment
+    parameters; summary and files as :func:`passage_output`, plus the trimmed uplift.
+    ``lumped``: the model's :class:`~symcat.pantograph.LumpedPantograph` (for ``lumped_scene``;
+    its own aerodynamic force, so ``aero_force`` is for ``seo2005`` only)."""
+    from .scene_passage import lumped_fragment, run_scene_passage, seo2005_fragment
 
-    fragment = seo2005_fragment(p["contact"], p["contact_stiffness"], p["contact_damping"], aero_force=aero_force)
+    from ..catenary import find_form
+
     o = numerical_options(p)
+    form = find_form(design, o["elements_per_span"], o["element"], progress=o["progress"])
+    if p["pantograph"] == "lumped_scene":
+        fragment = lumped_fragment(lumped, p["contact"], p["contact_stiffness"], p["contact_damping"], form=form)
+    else:
+        fragment = seo2005_fragment(p["contact"], p["contact_stiffness"], p["contact_damping"], aero_force=aero_force)
     result = run_scene_passage(design, fragment, speed, target_force, elements_per_span=o["elements_per_span"],
                                element=o["element"], analysis_spans=o["analysis_spans"], dt=o["dt"],
                                rho_inf=o["rho_inf"], tol=o["tol"], t_end=o["t_end"], record_every=o["record_every"],
-                               progress=o["progress"], contact=p["contact"])
+                               progress=o["progress"], contact=p["contact"], form=form)
     extra = {**extra, "pantograph": p["pantograph"], "uplift_N": result.uplift_N,
              "static_contact_force_N": result.static_contact_force_N,
              "target_static_contact_force_N": result.target_force_N, "uplift_static_solves": result.static_solves}

@@ -144,6 +144,32 @@ def seo2005_fragment(contact: str = "penalty", contact_stiffness: float = 5.0e4,
                            description="seo2005 four-body pantograph")
 
 
+def lumped_fragment(pantograph, contact: str = "penalty", contact_stiffness: float = 5.0e4,
+                    contact_damping: float = 0.0, contact_smoothing: float = 1.0e-5,
+                    form: FormFindingResult | None = None) -> ScenePantograph:
+    """A lumped-mass pantograph (:class:`~symcat.pantograph.LumpedPantograph`: its stages,
+    springs, dampers, uplift and aerodynamic force) as scene bodies
+    (:func:`symcat.pantograph.lumped_scene.add_lumped_pantograph`), a :class:`ScenePantograph`:
+    the interaction path's pantograph on the shared multibody path. The trimmed uplift replaces
+    ``pantograph.uplift``. With the catenary's ``form``, the pan-head is placed as the
+    interaction path places it (on the wire's static height under its static force,
+    :func:`~symcat.pantograph.lumped_scene.loaded_wire_height`), so that the nominal uplift gives
+    the static force and the trim takes one static solve."""
+    from dataclasses import replace
+
+    from ..pantograph.lumped_scene import add_lumped_pantograph, loaded_wire_height
+
+    def add(scene, wire, x0, speed, uplift):
+        panto = replace(pantograph, uplift=float(uplift))
+        head_z = None if form is None else loaded_wire_height(form, x0, float(panto.static_force(speed).sum()))
+        info = add_lumped_pantograph(scene, panto, wire, x0, speed, contact=contact, contact_stiffness=contact_stiffness,
+                                     contact_damping=contact_damping, smoothing=contact_smoothing, head_z=head_z)
+        return info["contact"]
+
+    return ScenePantograph(add, uplift=float(pantograph.uplift), name=f"{pantograph.name} (scene)",
+                           description=f"{pantograph.name} as scene bodies")
+
+
 class SceneRecord:
     """Histories of a :func:`run_scene_passage`, under :class:`~.recorder.PassageRecorder`'s names
     (one pantograph, one contact wire).
