@@ -334,8 +334,9 @@ class MultibodyModel:
             self._rayleigh = to_casadi_sparse(c)
         return self._rayleigh
 
-    def forces(self, q: ca.MX, v: ca.MX, t: ca.MX, part: str = "all") -> ca.MX:
-        """All applied, internal and quadratic-velocity forces (N, N m), Rayleigh damping included.
+    def forces(self, q: ca.MX, v: ca.MX, t: ca.MX, part: str = "all", rayleigh: bool = True) -> ca.MX:
+        """All applied, internal and quadratic-velocity forces (N, N m), Rayleigh damping included
+        (unless ``rayleigh=False``: a caller that multiplies the constant matrix itself).
 
         ``part``: ``"all"``; ``"bulk"``, the terms that act on ANCF coordinates only (element
         forces, Rayleigh damping, force elements between nodes or from a node to the ground),
@@ -347,7 +348,7 @@ class MultibodyModel:
         f = ca.MX(self.n_q, 1)
         if n_a and part != "rest":
             f += ca.vertcat(self.ancf.force_function()(q[:n_a], v[:n_a]), ca.MX(self.n_q - n_a, 1))
-            if self.ancf.rayleigh_matrix is not None:  # Rayleigh damping: constant sparse C times v
+            if rayleigh and self.ancf.rayleigh_matrix is not None:  # constant sparse C times v
                 f -= ca.mtimes(self._rayleigh_dm(), v)
         if self.scene.rigid_bodies and part != "bulk":
             bodies = self.scene.rigid_bodies

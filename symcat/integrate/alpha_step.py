@@ -79,7 +79,7 @@ class Bulk:
         mass_rest = ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(form.q_fixed + ca.mtimes(form.P, q_f), "rest"),
                                                   form.P))
         self._mass_rest = ca.Function("alpha_mass_rest", [q_f], [mass_rest])
-        self.residual = self.jacobian = None
+        self._forces = self.jacobian = None
         if not n_b:
             return
         zero = ca.MX(form.n_f - n_b, 1)
@@ -92,7 +92,12 @@ class Bulk:
         m_all = ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(q, "bulk"), form.P))
         f_b = ca.mtimes(form.P.T, model.forces(q, v, t, "bulk"))[:n_b]
         r_b = bh2 * (ca.mtimes(m_all[:n_b, :n_b], cm * a_b + b[:n_b]) - f_b)
-        fns = [ca.Function("alpha_bulk", [y_b, p, shift_b], [ca.densify(r_b)]),
+        # The residual's constant-matrix terms (mass, Rayleigh) are SciPy products below; CasADi
+        # evaluates the nonlinear forces only.
+        v_b, t_s = ca.MX.sym("v_b", n_b), ca.MX.sym("t")
+        f_nl = ca.mtimes(form.P.T, model.forces(q, ca.mtimes(form.P, ca.vertcat(v_b, zero)), t_s, "bulk",
+                                                rayleigh=False))[:n_b]
+        fns = [ca.Function("alpha_bulk_forces", [y_b, v_b, t_s], [ca.densify(f_nl)]),
                ca.Function("alpha_bulk_jacobian", [y_b, p, shift_b], [ca.jacobian(r_b, y_b)])]
         if expand:
             try:
@@ -101,12 +106,23 @@ class Bulk:
                 pass
         # Evaluated in place on NumPy memory: a call with NumPy arguments converts them to DM
         # and back, which on a line of 7,000 unknowns costs more than the evaluation itself.
-        self.residual, self.jacobian = (BufferedFunction(fn) for fn in fns)
+        self._forces, self.jacobian = (BufferedFunction(fn) for fn in fns)
         m_const = ca.evalf(ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(ca.MX.zeros(model.n_q), "bulk"), form.P)))
         self.mass_matrix = _csc(m_const)[:n_b, :n_b]
         c = model.ancf.rayleigh_matrix
         self.rayleigh = (_csc(ca.evalf(ca.mtimes(form.P.T, ca.mtimes(model._rayleigh_dm(), form.P))))[:n_b, :n_b]
                          if c is not None else sps.csc_matrix((n_b, n_b)))
+        self._mass_csr, self._rayleigh_csr = self.mass_matrix.tocsr(), self.rayleigh.tocsr()
+
+    def residual(self, y_b, p, shift_b) -> np.ndarray:
+        """The bulk's rows of the scaled step residual at the bulk unknowns ``y_b``, step data
+        ``p`` and stabilization shift ``shift_b``."""
+        n_b, n_u = self.n_b, self.n_u
+        u_pred, v_pred, b, t, bh2, gh, cm = _data(p, n_u)
+        a = (y_b - u_pred[:n_b] - shift_b) / bh2
+        v = v_pred[:n_b] + gh * a
+        f = self._forces.nonzeros(y_b, v, t)[0]
+        return bh2 * (self._mass_csr @ (cm * a + b[:n_b]) + self._rayleigh_csr @ v - f)
 
     def mass(self, q_f: np.ndarray) -> sps.csc_matrix:
         """The mass matrix on the free coordinates at ``q_f``."""
@@ -282,7 +298,7 @@ class StepEquations:
         r, shift = self._rest_values(y, p)
         n_b = self.bulk.n_b
         if n_b:
-            r[:n_b] += self.bulk.residual.nonzeros(y[:n_b], p, shift[:n_b])[0]
+            r[:n_b] += self.bulk.residual(y[:n_b], p, shift[:n_b])
         return r
 
     def contacts(self, u, v, sc, t) -> tuple[np.ndarray, np.ndarray]:
