@@ -108,8 +108,9 @@ PANTOGRAPH_CHOICES = ("lumped", "lumped_scene", "seo2005")
 PANTOGRAPH_PARAMETER = Parameter(
     "pantograph", "lumped", "", "pantograph model: lumped (the model's lumped-mass pantograph on the interaction "
     "path), lumped_scene (the same pantograph as scene bodies on the shared multibody path) or seo2005 (the seed "
-    "paper's four-body pantograph as scene bodies); on the multibody path one pantograph, one tension section, the "
-    "uplift trimmed to the static contact force", choices=PANTOGRAPH_CHOICES)
+    "paper's four-body pantograph as scene bodies); on the multibody path one tension section (and two pantographs "
+    "for lumped_scene with penalty contact only), the uplift trimmed to the static contact force",
+    choices=PANTOGRAPH_CHOICES)
 
 
 def check_scene_pantograph(p: dict, stagger: float, n_pantographs: int = 1, tension_sections: int = 1,
@@ -131,9 +132,10 @@ def check_scene_pantograph(p: dict, stagger: float, n_pantographs: int = 1, tens
     if p.get("pantograph", "lumped") == "lumped":
         return
     name = f"pantograph={p['pantograph']}"
-    if n_pantographs != 1:
-        raise ParameterError(f"n_pantographs={n_pantographs} with {name}: the multibody pantograph runs alone "
-                             "(n_pantographs=1); two pantographs need pantograph=lumped")
+    if n_pantographs != 1 and not (p["pantograph"] == "lumped_scene" and p["contact"] == "penalty"):
+        raise ParameterError(f"n_pantographs={n_pantographs} with {name} and contact={p['contact']}: this multibody "
+                             "pantograph runs alone (n_pantographs=1); two pantographs need pantograph=lumped, or "
+                             "pantograph=lumped_scene with contact=penalty")
     if tension_sections != 1:
         raise ParameterError(f"tension_sections={tension_sections} with {name}: the multibody passage runs on one "
                              "tension section (tension_sections=1); overlaps need pantograph=lumped")
@@ -165,13 +167,17 @@ def run_scene_pantograph(design, p: dict, speed: float, target_force: float, ste
     o = numerical_options(p)
     form = find_form(design, o["elements_per_span"], o["element"], progress=o["progress"])
     if p["pantograph"] == "lumped_scene":
-        fragment = lumped_fragment(lumped, p["contact"], p["contact_stiffness"], p["contact_damping"], form=form)
+        n = p.get("n_pantographs", 1)
+        fragment = [lumped_fragment(lumped, p["contact"], p["contact_stiffness"], p["contact_damping"], form=form,
+                                    name="pantograph" if n == 1 else f"pantograph_{k + 1}") for k in range(n)]
+        fragment = fragment[0] if n == 1 else fragment
     else:
         fragment = seo2005_fragment(p["contact"], p["contact_stiffness"], p["contact_damping"], aero_force=aero_force)
     result = run_scene_passage(design, fragment, speed, target_force, elements_per_span=o["elements_per_span"],
                                element=o["element"], analysis_spans=o["analysis_spans"], dt=o["dt"],
                                rho_inf=o["rho_inf"], tol=o["tol"], t_end=o["t_end"], record_every=o["record_every"],
-                               progress=o["progress"], contact=p["contact"], form=form)
+                               progress=o["progress"], contact=p["contact"], form=form,
+                               spacing=p.get("spacing_m", 200.0))
     extra = {**extra, "pantograph": p["pantograph"], "uplift_N": result.uplift_N,
              "static_contact_force_N": result.static_contact_force_N,
              "target_static_contact_force_N": result.target_force_N, "uplift_static_solves": result.static_solves}

@@ -56,8 +56,9 @@ uplift to ``force_rtol``: the pantograph's geometry changes a little with its he
 static contact force of a pantograph pressing on the wire is affine in its uplift. The seed
 paper's four-body pantograph plugs in through the same mechanism (:func:`seo2005_fragment`).
 
-Limits: one pantograph, one tension section (no overlaps), the nonlinear wires (no
-``wires="linear"``). Not recorded on this path (a :class:`SceneRecord` lists them in
+Several pantographs: pass a list of fragments with distinct element names (penalty contacts),
+``spacing`` apart, leading first (:func:`lumped_fragment` takes a ``name``). Limits: one tension
+section (no overlaps), the nonlinear wires (no ``wires="linear"``). Not recorded on this path (a :class:`SceneRecord` lists them in
 ``not_computed``): the energy balance of the passage and the Newton iterations per step.
 """
 from __future__ import annotations
@@ -146,7 +147,7 @@ def seo2005_fragment(contact: str = "penalty", contact_stiffness: float = 5.0e4,
 
 def lumped_fragment(pantograph, contact: str = "penalty", contact_stiffness: float = 5.0e4,
                     contact_damping: float = 0.0, contact_smoothing: float = 1.0e-5,
-                    form: FormFindingResult | None = None) -> ScenePantograph:
+                    form: FormFindingResult | None = None, name: str = "pantograph") -> ScenePantograph:
     """A lumped-mass pantograph (:class:`~symcat.pantograph.LumpedPantograph`: its stages,
     springs, dampers, uplift and aerodynamic force) as scene bodies
     (:func:`symcat.pantograph.lumped_scene.add_lumped_pantograph`), a :class:`ScenePantograph`:
@@ -154,7 +155,8 @@ def lumped_fragment(pantograph, contact: str = "penalty", contact_stiffness: flo
     ``pantograph.uplift``. With the catenary's ``form``, the pan-head is placed as the
     interaction path places it (on the wire's static height under its static force,
     :func:`~symcat.pantograph.lumped_scene.loaded_wire_height`), so that the nominal uplift gives
-    the static force and the trim takes one static solve."""
+    the static force and the trim takes one static solve. ``name`` prefixes its elements (two
+    pantographs on one line need two names)."""
     from dataclasses import replace
 
     from ..pantograph.lumped_scene import add_lumped_pantograph, loaded_wire_height
@@ -163,7 +165,8 @@ def lumped_fragment(pantograph, contact: str = "penalty", contact_stiffness: flo
         panto = replace(pantograph, uplift=float(uplift))
         head_z = None if form is None else loaded_wire_height(form, x0, float(panto.static_force(speed).sum()))
         info = add_lumped_pantograph(scene, panto, wire, x0, speed, contact=contact, contact_stiffness=contact_stiffness,
-                                     contact_damping=contact_damping, smoothing=contact_smoothing, head_z=head_z)
+                                     contact_damping=contact_damping, smoothing=contact_smoothing, head_z=head_z,
+                                     name=name)
         return info["contact"]
 
     return ScenePantograph(add, uplift=float(pantograph.uplift), name=f"{pantograph.name} (scene)",
@@ -234,17 +237,17 @@ class SceneLine:
     static catenary and where the pan-head is."""
 
     def __init__(self, form: FormFindingResult, speed: float, contact: str, n: int, record: SceneRecord | None,
-                 x_start: float):
+                 x_start):
         self.speed, self.contact, self.n = speed, contact, n
         self.q_static = np.asarray(form.q, float).copy()
-        self._record, self.x_start = record, x_start
+        self._record, self.x_start = record, np.atleast_1d(np.asarray(x_start, float))
 
     def x_contact(self, t: float) -> np.ndarray:
-        """Pan-head position(s) (m) at ``t`` (s), from the record."""
+        """Pan-head positions (m, leading first) at ``t`` (s), from the record."""
         rec = self._record
         if rec is None:
-            return np.array([self.x_start])
-        return np.array([np.interp(t, rec.t_s, rec.x_contact_m[:, 0])])
+            return self.x_start.copy()
+        return np.array([np.interp(t, rec.t_s, rec.x_contact_m[:, k]) for k in range(rec.x_contact_m.shape[1])])
 
 
 @dataclass
@@ -290,10 +293,15 @@ class ScenePassageResult:
     simulated_s: float = 0.0
 
     def pantograph_text(self) -> str:
-        """The pantograph in words (plot titles)."""
+        """The pantograph(s) in words (plot titles)."""
         p = self.pantograph
         what = p.description or f"{p.name} pantograph"
-        return f"{what} ({self.uplift_N:.1f} N uplift, {self.static_contact_force_N:.0f} N static contact force)"
+        up, force = np.atleast_1d(self.uplift_N), np.atleast_1d(self.static_contact_force_N)
+        text = f"{what} ({up[0]:.1f} N uplift, {force[0]:.0f} N static contact force)"
+        if up.size > 1:
+            spacing = abs(self.line.x_start[0] - self.line.x_start[1])
+            text = f"{up.size} x {text}, {spacing:g} m apart"
+        return text
 
 
 def _contact_element(scene, name: str):
@@ -316,18 +324,48 @@ def static_force(eq, element) -> float:
     return -float(eq.reactions_N[element.name][2])
 
 
-def _static(form, pantograph: ScenePantograph, wire: str, x0: float, speed: float, uplift: float):
-    """Scene, model, contact element and equilibrium with ``uplift`` (N)."""
+def _static(form, pantographs, wire: str, positions, speed: float, uplifts):
+    """Scene, model, contact elements and equilibrium of the ``pantographs`` at ``positions``
+    (m) with ``uplifts`` (N)."""
     from ..analysis.equilibrium import solve_equilibrium
     from ..assembly.multibody import MultibodyModel
     from ..catenary.scene import catenary_scene
 
     scene = catenary_scene(form)
-    name = pantograph.add(scene, wire, x0, speed, float(uplift))
-    element = _contact_element(scene, name)
+    elements = [_contact_element(scene, panto.add(scene, wire, x0, speed, float(u)))
+                for panto, x0, u in zip(pantographs, positions, uplifts)]
     model = MultibodyModel(scene)
     eq = solve_equilibrium(model)
-    return scene, model, element, eq
+    return scene, model, elements, eq
+
+
+def trim_uplifts(form, pantographs, target_force: float, wire: str, positions, speed: float,
+                 force_rtol: float = 1e-9, max_solves: int = 8):
+    """:func:`trim_uplift` for several pantographs on one line (each trimmed to ``target_force``
+    by its own secant: they interact only through the wire, weakly). Returns lists of uplifts
+    and forces, the static state (with a list of contact elements) and the solves."""
+    if len(pantographs) == 1:
+        u, f, (scene, model, element, eq), solves = trim_uplift(form, pantographs[0], target_force, wire, positions[0],
+                                                                 speed, force_rtol, max_solves)
+        return [u], [f], (scene, model, [element], eq), solves
+    u0 = np.array([float(p.uplift) for p in pantographs])
+    built = _static(form, pantographs, wire, positions, speed, u0)
+    f0 = np.array([static_force(built[3], e) for e in built[2]])
+    solves, u1 = 1, u0 + (target_force - f0)
+    while np.abs(f0 - target_force).max() > force_rtol * abs(target_force):
+        if solves >= max_solves:
+            raise SolverError(f"pantographs: the uplift trim did not reach the static contact force {target_force:g} N "
+                              f"in {max_solves} static solves (last {f0.tolist()} N)")
+        built1 = _static(form, pantographs, wire, positions, speed, u1)
+        f1 = np.array([static_force(built1[3], e) for e in built1[2]])
+        solves += 1
+        slope = np.where(u1 != u0, (f1 - f0) / np.where(u1 != u0, u1 - u0, 1.0), 1.0)
+        if not np.all(slope > 0):
+            raise SolverError(f"pantographs: the static contact force does not grow with the uplift ({f0.tolist()} N at "
+                              f"{u0.tolist()} N, {f1.tolist()} N at {u1.tolist()} N)")
+        u0, f0, built = u1, f1, built1
+        u1 = u1 + (target_force - f1) / slope
+    return u0.tolist(), f0.tolist(), built, solves
 
 
 def trim_uplift(form, pantograph: ScenePantograph, target_force: float, wire: str, x0: float, speed: float,
@@ -343,14 +381,14 @@ def trim_uplift(form, pantograph: ScenePantograph, target_force: float, wire: st
         static solves.
     """
     u0 = float(pantograph.uplift)
-    built = _static(form, pantograph, wire, x0, speed, u0)
+    built = _one(_static(form, [pantograph], wire, [x0], speed, [u0]))
     f0 = static_force(built[3], built[2])
     solves = 1
     u1 = u0 + (target_force - f0)  # unit sensitivity as the first guess (uplift at the pan-head)
     while solves < max_solves:
         if abs(f0 - target_force) <= force_rtol * abs(target_force):
             return u0, f0, built, solves
-        built1 = _static(form, pantograph, wire, x0, speed, u1)
+        built1 = _one(_static(form, [pantograph], wire, [x0], speed, [u1]))
         f1 = static_force(built1[3], built1[2])
         solves += 1
         if not (f1 > 0 or f0 > 0):
@@ -368,17 +406,25 @@ def trim_uplift(form, pantograph: ScenePantograph, target_force: float, wire: st
                       f"{target_force:g} N in {max_solves} static solves (last {f0:g} N at {u0:g} N uplift)")
 
 
-def _monitor(form, model, element):
-    """Per-step records of a penalty contact's passage (generalized-alpha's ``monitor``): what
-    the statistics need at every step, without a full output per step."""
+def _one(built):
+    """A static state of one pantograph: its contact element instead of the list."""
+    scene, model, elements, eq = built
+    return scene, model, elements[0], eq
+
+
+def _monitor(form, model, elements):
+    """Per-step records of the penalty contacts' passage (generalized-alpha's ``monitor``):
+    what the statistics need at every step, without a full output per step (one column per
+    pantograph)."""
     st = form.structure
-    head = model.rigid_offset[element.body]
-    k = [ct.joint.name for ct in model.contacts].index(element.name)
+    heads = np.array([model.rigid_offset[e.body] for e in elements])
+    names = [ct.joint.name for ct in model.contacts]
+    k = np.array([names.index(e.name) for e in elements])
     supports = st.cw_xyz[st.support_nodes, 2]
 
     def monitor(s):
-        return {"x_contact_m": s.q[head], "contact_force_N": s.force_N[k], "penetration_m": -s.gap_m[k],
-                "panhead_z_m": s.q[head + 2], "panhead_acc_m_s2": s.a[head + 2], "support_z_m": s.q[supports],
+        return {"x_contact_m": s.q[heads], "contact_force_N": s.force_N[k], "penetration_m": -s.gap_m[k],
+                "panhead_z_m": s.q[heads + 2], "panhead_acc_m_s2": s.a[heads + 2], "support_z_m": s.q[supports],
                 "dropper_tension_N": st.dropper_state(s.q[: st.n])[2]}
 
     return monitor
@@ -394,9 +440,9 @@ def _record(res, form, model, element, snapshot_every: float) -> dict:
     if res.monitored:
         m = res.monitored
         snap = _snapshots(np.asarray(res.t_s), snapshot_every)
-        return {"t_s": m["t_s"], **{key: m[key][:, None] for key in ("x_contact_m", "contact_force_N", "penetration_m",
-                                                                      "panhead_z_m", "panhead_acc_m_s2")},
-                "contact_force_wire_N": m["contact_force_N"][:, None, None], "support_z_m": m["support_z_m"],
+        return {"t_s": m["t_s"], **{key: m[key] for key in ("x_contact_m", "contact_force_N", "penetration_m",
+                                                             "panhead_z_m", "panhead_acc_m_s2")},
+                "contact_force_wire_N": m["contact_force_N"][:, :, None], "support_z_m": m["support_z_m"],
                 "dropper_tension_N": m["dropper_tension_N"], "snapshot_t_s": np.asarray(res.t_s)[snap],
                 "snapshot_q": q[snap, : st.n]}
     head = model.rigid_offset[element.body]
@@ -438,7 +484,7 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
                       lead_in: float | None = None, dt: float = 1e-3, rho_inf: float = 0.8, tol: float = 1e-4,
                       t_end: float | None = None, record_every: float = 0.05, progress: bool = True,
                       form: FormFindingResult | None = None, wire: str = "contact", contact: str = "penalty",
-                      force_rtol: float = 1e-9) -> ScenePassageResult:
+                      force_rtol: float = 1e-9, spacing: float = 200.0) -> ScenePassageResult:
     """Run a multibody ``pantograph`` over the form-found ``design`` at ``speed`` (m/s) with the
     static contact force ``target_force`` (N); EN 50318 statistics as :func:`~.passage.run_passage`.
 
@@ -472,10 +518,14 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
         The contact model in words (plot titles); the fragment decides the actual one.
     force_rtol : float
         Relative accuracy of the static contact force.
+    spacing : float
+        Distance (m) between pantographs when ``pantograph`` is a list (leading first, as
+        :func:`~.passage.run_passage` places them; penalty contacts, distinct element names).
 
     Returns
     -------
     ScenePassageResult
+        ``uplift_N`` and ``static_contact_force_N`` are lists with several pantographs.
     """
     from ..integrate import generalized_alpha
 
@@ -486,37 +536,43 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
         raise ParameterError(f"speed={speed:g} m/s: must be > 0")
     if not target_force > 0:
         raise ParameterError(f"target_force={target_force:g} N: must be > 0")
-    section, x0, duration = passage_plan(design, 1, speed, 200.0, analysis_spans, lead_in, t_end)
+    pantographs = list(pantograph) if isinstance(pantograph, (list, tuple)) else [pantograph]
+    n_p = len(pantographs)
+    section, x_trail, duration = passage_plan(design, n_p, speed, spacing, analysis_spans, lead_in, t_end)
+    positions = [x_trail + spacing * (n_p - 1 - k) for k in range(n_p)]  # leading first
     if form is None:
         form = find_form(design, elements_per_span, element, progress=progress)
     if progress:
-        notice(f"trimming the uplift of the {pantograph.name} pantograph to a static contact force of "
-               f"{target_force:g} N (static solves of the joint equilibrium)")
-    uplift, f_static, (_, model, el, eq), solves = trim_uplift(form, pantograph, target_force, wire, x0, speed,
-                                                                   force_rtol)
+        notice(f"trimming the uplift of the {pantographs[0].name} pantograph{'s' if n_p > 1 else ''} to a static "
+               f"contact force of {target_force:g} N (static solves of the joint equilibrium)")
+    uplifts, forces, (_, model, elements, eq), solves = trim_uplifts(form, pantographs, target_force, wire, positions,
+                                                                     speed, force_rtol)
+    from ..scene import PenaltyContact
+
+    if n_p > 1 and not all(isinstance(e, PenaltyContact) for e in elements):
+        raise ParameterError(f"{n_p} pantographs on the multibody path: their contacts must be penalty contacts "
+                             "(a sliding joint's force is read from outputs of one pantograph only)")
     eq.apply(model)
-    line = SceneLine(form, speed, contact, model.n_q, None, x0)
-    out = ScenePassageResult(form, line, None, section, [], uplift, f_static, float(target_force), solves, pantograph,
-                             model)
+    line = SceneLine(form, speed, contact, model.n_q, None, positions)
+    out = ScenePassageResult(form, line, None, section, [], uplifts[0] if n_p == 1 else uplifts,
+                             forces[0] if n_p == 1 else forces, float(target_force), solves, pantographs[0], model)
     if duration == 0:
         out.wall_s = time.perf_counter() - t0
         return out
     n_steps = math.ceil(duration / dt - 1e-9)
-    from ..scene import PenaltyContact
-
     # A penalty contact's passage is recorded at every step by a monitor, with full outputs only
     # for the snapshots; a sliding joint's force comes from the outputs' joint reactions.
-    monitor = _monitor(form, model, el) if isinstance(el, PenaltyContact) else None
+    monitor = _monitor(form, model, elements) if isinstance(elements[0], PenaltyContact) else None
     # Snapshots every `per` steps, `per` a divisor of the steps: the step stays dt exactly.
     per = max(d for d in range(1, max(1, round(record_every / dt)) + 1) if n_steps % d == 0)
     n_out = n_steps if monitor is None else n_steps // per
     res = generalized_alpha(model, duration, dt, rho_inf, n_out=n_out, tol=tol, progress=progress,
                             multipliers="integrator", monitor=monitor)  # no KKT solve per output
-    rec = SceneRecord(_record(res, form, model, el, record_every), form, speed, dict(res.stats))
-    rec.uplift_N, rec.static_contact_force_N = uplift, f_static
+    rec = SceneRecord(_record(res, form, model, elements[0], record_every), form, speed, dict(res.stats))
+    rec.uplift_N, rec.static_contact_force_N = out.uplift_N, out.static_contact_force_N
     line._record = rec
-    stats = [pantograph_statistics(rec.t_s, rec.x_contact_m[:, 0], rec.contact_force_N[:, 0], section,
-                                   form.structure, rec.support_z_m, rec.static_support_z_m)]
+    stats = [pantograph_statistics(rec.t_s, rec.x_contact_m[:, k], rec.contact_force_N[:, k], section,
+                                   form.structure, rec.support_z_m, rec.static_support_z_m) for k in range(n_p)]
     out.record, out.statistics, out.simulation = rec, stats, res
     out.simulated_s = float(rec.t_s[-1])
     out.wall_s = time.perf_counter() - t0
