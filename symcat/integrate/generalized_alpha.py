@@ -73,7 +73,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse.linalg as spla
@@ -85,64 +85,13 @@ from ..errors import ParameterError, SolverError
 from ..progress import Progress
 from ..run_control import check_interrupt, ended_early, integrating
 from .alpha_coefficients import AlphaCoefficients
+from .alpha_run import AlphaRun, StepState
 from .alpha_step import StepEquations, solve_step
-from .results import SimulationResult, collect_result
+from .results import SimulationResult
 from .simulate import update_windows
 
 VARIANTS = ("index3", "stabilized")
 
-
-
-@dataclass
-class AlphaRun:
-    """What :func:`integrate_alpha` computed: outputs in the augmented index-1 layout of
-    ``form`` (``xs``, ``zs``, see :meth:`Formulation.blocks`), the integrator's own multipliers
-    ``lambda_{n+1}`` (n_t, n_c) and statistics (``steps`` taken, halved ones included,
-    ``newton_iterations``, ``factorizations``, ``rebuilds`` after element-window moves,
-    ``halvings`` of failed steps, ``build_s`` the wall time spent building the step's functions,
-    ``dt``, ``rho_inf``, ``variant``)."""
-
-    form: Formulation
-    t_s: np.ndarray
-    xs: list
-    zs: list
-    multipliers: np.ndarray
-    stats: dict = field(default_factory=dict)
-    walls: list = field(default_factory=list)
-    monitored: dict = field(default_factory=dict)
-
-    def result(self, wall0: float | None = None, multipliers: str = "kkt") -> SimulationResult:
-        """The :class:`SimulationResult` of these outputs (as :func:`simulate` returns it);
-        ``multipliers`` as for :func:`generalized_alpha`."""
-        n = len(self.xs)
-        wall0 = time.perf_counter() - self.stats.get("wall_s", 0.0) if wall0 is None else wall0
-        given = None
-        if multipliers == "integrator":
-            zb = self.form.blocks()[1]
-            given = (np.asarray(self.zs, float).reshape(n, -1)[:, zb["a"].slice], self.multipliers[:n])
-        res = collect_result(self.form, self.t_s[:n], self.xs, self.zs, self.stats, wall0, [()] * n, [],
-                             self.walls, given)
-        res.monitored = {key: np.asarray(values) for key, values in self.monitored.items()}
-        return res
-
-
-@dataclass
-class StepState:
-    """What a ``monitor`` of :func:`generalized_alpha` sees after each step (SI units): time
-    ``t_s``, all coordinates ``q``, velocities ``v`` and accelerations ``a`` (fixed ones
-    included, ``model.coordinate_names()``), the sliding-joint arc lengths ``s_m``, the
-    integrator's multipliers, and per penalty contact (``model.contacts``) the arc length
-    ``sc_m``, normal gap ``gap_m`` (> 0 separated) and normal force ``force_N``."""
-
-    t_s: float
-    q: np.ndarray
-    v: np.ndarray
-    a: np.ndarray
-    s_m: np.ndarray
-    multipliers: np.ndarray
-    sc_m: np.ndarray
-    gap_m: np.ndarray
-    force_N: np.ndarray
 
 
 @dataclass
@@ -218,8 +167,7 @@ class _Integrator:
         """One step of size ``h`` from ``s`` at ``t0``; None if its Newton iteration fails."""
         st = self.stepper
         p = self.data(s, t0, h)
-        done = solve_step(st, self.predictor(s, p, h), p, st.n_u, st.n_c, st.n_sc, self.tol, self.max_iterations,
-                       self.stats)
+        done = solve_step(st, self.predictor(s, p, h), p, self.tol, self.max_iterations, self.stats)
         if done is None:
             return None
         y, a, v, v_dot = done

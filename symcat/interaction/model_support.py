@@ -160,7 +160,8 @@ def run_scene_pantograph(design, p: dict, speed: float, target_force: float, ste
     parameters; summary and files as :func:`passage_output`, plus the trimmed uplift.
     ``lumped``: the model's :class:`~symcat.pantograph.LumpedPantograph` (for ``lumped_scene``;
     its own aerodynamic force, so ``aero_force`` is for ``seo2005`` only)."""
-    from .scene_passage import lumped_fragment, run_scene_passage, seo2005_fragment
+    from .scene_pantographs import lumped_fragment, seo2005_fragment
+    from .scene_passage import run_scene_passage
 
     from ..catenary import find_form
 

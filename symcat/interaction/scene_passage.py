@@ -65,7 +65,6 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -73,12 +72,21 @@ import numpy as np
 
 from ..catenary.design import CatenaryDesign
 from ..catenary.formfinding import FormFindingResult, find_form
-from ..errors import ParameterError, SolverError
+from ..errors import ParameterError
 from ..progress import notice
 from .passage import pantograph_statistics, passage_plan
+from .scene_pantographs import (
+    PantographFragment,
+    ScenePantograph,
+    lumped_fragment,
+    seo2005_fragment,
+    static_force,
+    trim_uplift,
+    trim_uplifts,
+)
 
-#: ``add(scene, wire, x0, speed, uplift) -> contact name`` (module docstring).
-PantographFragment = Callable[..., str]
+__all__ = ["PantographFragment", "ScenePantograph", "ScenePassageResult", "SceneRecord", "lumped_fragment",
+           "run_scene_passage", "seo2005_fragment", "static_force", "trim_uplift", "trim_uplifts"]
 
 #: Why a :class:`SceneRecord` has no value for these summary entries.
 NOT_COMPUTED = {
@@ -87,90 +95,6 @@ NOT_COMPUTED = {
     "contact_work_J": "not recorded on the multibody path",
     "newton_iterations_per_step": "not recorded per step on the multibody path (stats holds the total)",
 }
-
-
-@dataclass
-class ScenePantograph:
-    """A pantograph scene fragment for :func:`run_scene_passage`.
-
-    Attributes
-    ----------
-    add : callable
-        ``add(scene, wire, x0, speed, uplift) -> contact name`` (module docstring); units m,
-        m/s, N.
-    uplift : float
-        First guess of the uplift (N) that gives the target static contact force.
-    name : str
-        Shown in plot titles and the summary.
-    description : str
-        One line about the model (plot titles).
-    """
-
-    add: PantographFragment
-    uplift: float = 100.0
-    name: str = "pantograph"
-    description: str = ""
-
-
-def seo2005_fragment(contact: str = "penalty", contact_stiffness: float = 5.0e4, contact_damping: float = 0.0,
-                     contact_smoothing: float = 1.0e-5, aero_force: float = 0.0, rod_stiffness: float = 5.0e5,
-                     prefix: str = "pantograph_") -> ScenePantograph:
-    """The seed paper's four-body pantograph (:func:`symcat.pantograph.add_seo2005_pantograph`)
-    as a :class:`ScenePantograph`.
-
-    Parameters
-    ----------
-    contact : {"penalty", "bilateral"}
-        Pan-head/wire contact (bilateral: a sliding joint, for an unstaggered wire only).
-    contact_stiffness, contact_damping, contact_smoothing : float
-        Penalty law (N/m, N s/m, m).
-    aero_force : float
-        Constant aerodynamic uplift (N) on the pan-head (``c v^2`` at the run's speed).
-    rod_stiffness : float
-        Coupling rod (N/m).
-    prefix : str
-        Before every element name.
-    """
-    from ..pantograph.seo2005 import add_seo2005_pantograph
-    from ..scene import PointLoad
-
-    def add(scene, wire, x0, speed, uplift):
-        names = add_seo2005_pantograph(scene, wire, x0, None, contact, None, speed, uplift, rod_stiffness,
-                                       contact_stiffness, contact_damping, contact_smoothing, prefix=prefix)
-        if aero_force:
-            scene.add(PointLoad(prefix + "aero", names["panhead"], force=(0.0, 0.0, float(aero_force))))
-        return names["contact"]
-
-    return ScenePantograph(add, uplift=265.0, name="seo2005",
-                           description="seo2005 four-body pantograph")
-
-
-def lumped_fragment(pantograph, contact: str = "penalty", contact_stiffness: float = 5.0e4,
-                    contact_damping: float = 0.0, contact_smoothing: float = 1.0e-5,
-                    form: FormFindingResult | None = None, name: str = "pantograph") -> ScenePantograph:
-    """A lumped-mass pantograph (:class:`~symcat.pantograph.LumpedPantograph`: its stages,
-    springs, dampers, uplift and aerodynamic force) as scene bodies
-    (:func:`symcat.pantograph.lumped_scene.add_lumped_pantograph`), a :class:`ScenePantograph`:
-    the interaction path's pantograph on the shared multibody path. The trimmed uplift replaces
-    ``pantograph.uplift``. With the catenary's ``form``, the pan-head is placed as the
-    interaction path places it (on the wire's static height under its static force,
-    :func:`~symcat.pantograph.lumped_scene.loaded_wire_height`), so that the nominal uplift gives
-    the static force and the trim takes one static solve. ``name`` prefixes its elements (two
-    pantographs on one line need two names)."""
-    from dataclasses import replace
-
-    from ..pantograph.lumped_scene import add_lumped_pantograph, loaded_wire_height
-
-    def add(scene, wire, x0, speed, uplift):
-        panto = replace(pantograph, uplift=float(uplift))
-        head_z = None if form is None else loaded_wire_height(form, x0, float(panto.static_force(speed).sum()))
-        info = add_lumped_pantograph(scene, panto, wire, x0, speed, contact=contact, contact_stiffness=contact_stiffness,
-                                     contact_damping=contact_damping, smoothing=contact_smoothing, head_z=head_z,
-                                     name=name)
-        return info["contact"]
-
-    return ScenePantograph(add, uplift=float(pantograph.uplift), name=f"{pantograph.name} (scene)",
-                           description=f"{pantograph.name} as scene bodies")
 
 
 class SceneRecord:
@@ -302,114 +226,6 @@ class ScenePassageResult:
             spacing = abs(self.line.x_start[0] - self.line.x_start[1])
             text = f"{up.size} x {text}, {spacing:g} m apart"
         return text
-
-
-def _contact_element(scene, name: str):
-    from ..scene import PenaltyContact, SlidingJoint
-
-    for e in scene.force_elements + scene.joints:
-        if e.name == name and isinstance(e, (PenaltyContact, SlidingJoint)):
-            return e
-    raise ParameterError(f"pantograph fragment: returned {name!r}, which is not a PenaltyContact or SlidingJoint of "
-                         "the scene; it must return the name of its pan-head/wire contact")
-
-
-def static_force(eq, element) -> float:
-    """Static contact force (N, pressing the pan-head down) of the contact ``element`` in the
-    equilibrium ``eq``: the penalty force, or minus the sliding joint's vertical reaction."""
-    from ..scene import PenaltyContact
-
-    if isinstance(element, PenaltyContact):
-        return float(eq.contact_force_N[element.name])
-    return -float(eq.reactions_N[element.name][2])
-
-
-def _static(form, pantographs, wire: str, positions, speed: float, uplifts):
-    """Scene, model, contact elements and equilibrium of the ``pantographs`` at ``positions``
-    (m) with ``uplifts`` (N)."""
-    from ..analysis.equilibrium import solve_equilibrium
-    from ..assembly.multibody import MultibodyModel
-    from ..catenary.scene import catenary_scene
-
-    scene = catenary_scene(form)
-    elements = [_contact_element(scene, panto.add(scene, wire, x0, speed, float(u)))
-                for panto, x0, u in zip(pantographs, positions, uplifts)]
-    model = MultibodyModel(scene)
-    eq = solve_equilibrium(model)
-    return scene, model, elements, eq
-
-
-def trim_uplifts(form, pantographs, target_force: float, wire: str, positions, speed: float,
-                 force_rtol: float = 1e-9, max_solves: int = 8):
-    """:func:`trim_uplift` for several pantographs on one line (each trimmed to ``target_force``
-    by its own secant: they interact only through the wire, weakly). Returns lists of uplifts
-    and forces, the static state (with a list of contact elements) and the solves."""
-    if len(pantographs) == 1:
-        u, f, (scene, model, element, eq), solves = trim_uplift(form, pantographs[0], target_force, wire, positions[0],
-                                                                 speed, force_rtol, max_solves)
-        return [u], [f], (scene, model, [element], eq), solves
-    u0 = np.array([float(p.uplift) for p in pantographs])
-    built = _static(form, pantographs, wire, positions, speed, u0)
-    f0 = np.array([static_force(built[3], e) for e in built[2]])
-    solves, u1 = 1, u0 + (target_force - f0)
-    while np.abs(f0 - target_force).max() > force_rtol * abs(target_force):
-        if solves >= max_solves:
-            raise SolverError(f"pantographs: the uplift trim did not reach the static contact force {target_force:g} N "
-                              f"in {max_solves} static solves (last {f0.tolist()} N)")
-        built1 = _static(form, pantographs, wire, positions, speed, u1)
-        f1 = np.array([static_force(built1[3], e) for e in built1[2]])
-        solves += 1
-        slope = np.where(u1 != u0, (f1 - f0) / np.where(u1 != u0, u1 - u0, 1.0), 1.0)
-        if not np.all(slope > 0):
-            raise SolverError(f"pantographs: the static contact force does not grow with the uplift ({f0.tolist()} N at "
-                              f"{u0.tolist()} N, {f1.tolist()} N at {u1.tolist()} N)")
-        u0, f0, built = u1, f1, built1
-        u1 = u1 + (target_force - f1) / slope
-    return u0.tolist(), f0.tolist(), built, solves
-
-
-def trim_uplift(form, pantograph: ScenePantograph, target_force: float, wire: str, x0: float, speed: float,
-                force_rtol: float = 1e-9, max_solves: int = 8):
-    """The uplift (N) whose static contact force is ``target_force`` (N): two static solves
-    (the force is affine in the uplift), then secant steps while the force is off by more than
-    ``force_rtol`` relative (the pantograph's geometry moves slightly with its height).
-
-    Returns
-    -------
-    uplift, force, (scene, model, element, eq), solves
-        The uplift (N), its static force (N), the static state built with it and the number of
-        static solves.
-    """
-    u0 = float(pantograph.uplift)
-    built = _one(_static(form, [pantograph], wire, [x0], speed, [u0]))
-    f0 = static_force(built[3], built[2])
-    solves = 1
-    u1 = u0 + (target_force - f0)  # unit sensitivity as the first guess (uplift at the pan-head)
-    while solves < max_solves:
-        if abs(f0 - target_force) <= force_rtol * abs(target_force):
-            return u0, f0, built, solves
-        built1 = _one(_static(form, [pantograph], wire, [x0], speed, [u1]))
-        f1 = static_force(built1[3], built1[2])
-        solves += 1
-        if not (f1 > 0 or f0 > 0):
-            raise ParameterError(f"pantograph {pantograph.name}: no contact at uplifts {u0:g} N and {u1:g} N; give a "
-                                 "first uplift guess that presses the pan-head on the wire")
-        slope = (f1 - f0) / (u1 - u0) if u1 != u0 else 0.0
-        if not slope > 0:
-            raise SolverError(f"pantograph {pantograph.name}: the static contact force does not grow with the uplift "
-                              f"({f0:g} N at {u0:g} N, {f1:g} N at {u1:g} N)")
-        u0, f0, built = u1, f1, built1
-        u1 = u1 + (target_force - f1) / slope
-    if abs(f0 - target_force) <= force_rtol * abs(target_force):
-        return u0, f0, built, solves
-    raise SolverError(f"pantograph {pantograph.name}: the uplift trim did not reach the static contact force "
-                      f"{target_force:g} N in {max_solves} static solves (last {f0:g} N at {u0:g} N uplift)")
-
-
-def _one(built):
-    """A static state of one pantograph: its contact element instead of the list."""
-    scene, model, elements, eq = built
-    return scene, model, elements[0], eq
 
 
 def _monitor(form, model, elements):

@@ -32,14 +32,10 @@ def line(request):
     return model
 
 
-@pytest.mark.parametrize("variant", ["stabilized", "index3"])
-def test_split_jacobian_and_woodbury_solve(line, variant):
-    form = Formulation(line, "augmented", "1")
-    st = StepEquations(form, variant)
-    assert 0 < st.bulk.n_b < st.n_y and st.rest_columns.size < st.n_y / 2
-    c, h = AlphaCoefficients(0.8), 1e-3
-    rng = np.random.default_rng(3)
-    n_u = st.n_u
+def _point(st, line, rng):
+    """Unknowns ``y`` near the static state and step data ``p`` (dt = 1 ms, rho_inf = 0.8) of a
+    step of ``st`` on ``line``."""
+    c, h, n_u = AlphaCoefficients(0.8), 1e-3, st.n_u
     u0 = np.r_[line.q0[line.free], line.s0]
     p = np.r_[u0, rng.normal(0, 1e-2, n_u), rng.normal(0, 1.0, n_u), 0.0, c.beta * h * h, c.gamma * h,
               (1 - c.alpha_m) / (1 - c.alpha_f)]
@@ -48,6 +44,16 @@ def test_split_jacobian_and_woodbury_solve(line, variant):
     y[n_u : n_u + st.n_c] = rng.normal(0, 1e-5, st.n_c)
     if st.n_sc:
         y[-st.n_sc :] = line.sc0
+    return y, p
+
+
+@pytest.mark.parametrize("variant", ["stabilized", "index3"])
+def test_split_jacobian_and_woodbury_solve(line, variant):
+    form = Formulation(line, "augmented", "1")
+    st = StepEquations(form, variant)
+    assert 0 < st.bulk.n_b < st.n_y and st.rest_columns.size < st.n_y / 2
+    rng = np.random.default_rng(3)
+    y, p = _point(st, line, rng)
     jac = st.jacobian(y, p).toarray()
     fd = np.empty_like(jac)
     for j in range(st.n_y):
@@ -72,17 +78,7 @@ def test_proxy_element_equals_the_window(line):
     proxied, windowed = StepEquations(form, "stabilized"), StepEquations(form, "stabilized", proxies=False)
     assert proxied.proxies is not None and windowed.proxies is None
     (sl, j, *_), = proxied.proxies.items
-    n_u = proxied.n_u
-    c, h = AlphaCoefficients(0.8), 1e-3
-    u0 = np.r_[line.q0[line.free], line.s0]
-    rng = np.random.default_rng(5)
-    p = np.r_[u0, rng.normal(0, 1e-2, n_u), rng.normal(0, 1.0, n_u), 0.0, c.beta * h * h, c.gamma * h,
-              (1 - c.alpha_m) / (1 - c.alpha_f)]
-    y = np.zeros(proxied.n_y)
-    y[:n_u] = u0 + rng.normal(0, 1e-5, n_u)
-    y[n_u : n_u + proxied.n_c] = rng.normal(0, 1e-5, proxied.n_c)
-    if proxied.n_sc:
-        y[-proxied.n_sc :] = line.sc0
+    y, p = _point(proxied, line, np.random.default_rng(5))
     s = y[proxied.proxies.items[0][-1]]
     assert not sl.element_start[j] <= s < sl.element_start[j + 1]  # the contact is elsewhere
     scale = np.abs(windowed.residual(y, p)).max()

@@ -1,0 +1,150 @@
+"""The window-independent part of a generalized-alpha step (:mod:`.alpha_step`): the wires'
+("bulk") residual rows and Jacobian, their constant mass and Rayleigh matrices, and the
+factorized bulk matrix with its cached columns."""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
+
+from ..assembly.banded import BandedCholesky
+from ..assembly.sparse import to_scipy
+from ..codegen.library import BufferedFunction
+from ..dae.formulation import Formulation
+from ..errors import SolverError
+
+#: Cached columns ``A^-1 e_i`` kept at most (a contact touches a dozen or two at a time).
+MAX_COLUMNS = 256
+
+
+def step_data(p, n_u):
+    """The pieces of the step's data ``p`` (see :class:`StepEquations`)."""
+    return (p[:n_u], p[n_u : 2 * n_u], p[2 * n_u : 3 * n_u], p[3 * n_u], p[3 * n_u + 1], p[3 * n_u + 2],
+            p[3 * n_u + 3])
+
+
+class Bulk:
+    """The window-independent part of the step: the bulk's residual rows and Jacobian as
+    functions of ``(y_b, p, shift_b)`` (the free ANCF coordinates come first among the
+    unknowns, ``n_b`` of them), the constant bulk mass and Rayleigh matrices, the mass matrix
+    of the rest, and the factorized bulk matrix ``A = c_m M + gamma h D + beta h^2 K`` with its
+    cached columns.
+
+    Parameters
+    ----------
+    form : Formulation
+    n_u : int
+        Free coordinates and sliding-joint arc lengths (the layout of ``p``).
+    expand : bool
+        Expand the bulk's functions to SX when the graph allows it.
+    """
+
+    def __init__(self, form: Formulation, n_u: int, expand: bool = False):
+        model = form.model
+        self.n_b = n_b = int(np.count_nonzero(model.free < model.ancf.n))
+        self.n_f, self.n_u = form.n_f, n_u
+        self.lu = None
+        self.bh2 = None
+        self.factorizations = 0
+        self._columns: dict[int, np.ndarray] = {}
+        self._permutation = None
+        q_f = ca.MX.sym("q", form.n_f)
+        mass_rest = ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(form.q_fixed + ca.mtimes(form.P, q_f), "rest"),
+                                                  form.P))
+        self._mass_rest = ca.Function("alpha_mass_rest", [q_f], [mass_rest])
+        self._forces = self.jacobian = None
+        if not n_b:
+            return
+        zero = ca.MX(form.n_f - n_b, 1)
+        y_b, shift_b = ca.MX.sym("y_b", n_b), ca.MX.sym("shift_b", n_b)
+        p = ca.MX.sym("p", 3 * n_u + 4)
+        u_pred, v_pred, b, t, bh2, gh, cm = step_data(p, n_u)
+        a_b = (y_b - u_pred[:n_b] - shift_b) / bh2
+        q = form.q_fixed + ca.mtimes(form.P, ca.vertcat(y_b, zero))
+        v = ca.mtimes(form.P, ca.vertcat(v_pred[:n_b] + gh * a_b, zero))
+        m_all = ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(q, "bulk"), form.P))
+        f_b = ca.mtimes(form.P.T, model.forces(q, v, t, "bulk"))[:n_b]
+        r_b = bh2 * (ca.mtimes(m_all[:n_b, :n_b], cm * a_b + b[:n_b]) - f_b)
+        # The residual's constant-matrix terms (mass, Rayleigh) are SciPy products below; CasADi
+        # evaluates the nonlinear forces only.
+        v_b, t_s = ca.MX.sym("v_b", n_b), ca.MX.sym("t")
+        f_nl = ca.mtimes(form.P.T, model.forces(q, ca.mtimes(form.P, ca.vertcat(v_b, zero)), t_s, "bulk",
+                                                rayleigh=False))[:n_b]
+        fns = [ca.Function("alpha_bulk_forces", [y_b, v_b, t_s], [ca.densify(f_nl)]),
+               ca.Function("alpha_bulk_jacobian", [y_b, p, shift_b], [ca.jacobian(r_b, y_b)])]
+        if expand:
+            try:
+                fns = [fn.expand() for fn in fns]
+            except RuntimeError:
+                pass
+        # Evaluated in place on NumPy memory: a call with NumPy arguments converts them to DM
+        # and back, which on a line of 7,000 unknowns costs more than the evaluation itself.
+        self._forces, self.jacobian = (BufferedFunction(fn) for fn in fns)
+        m_const = ca.evalf(ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(ca.MX.zeros(model.n_q), "bulk"), form.P)))
+        self.mass_matrix = to_scipy(m_const)[:n_b, :n_b]
+        c = model.ancf.rayleigh_matrix
+        self.rayleigh = (to_scipy(ca.evalf(ca.mtimes(form.P.T, ca.mtimes(model._rayleigh_dm(), form.P))))[:n_b, :n_b]
+                         if c is not None else sps.csc_matrix((n_b, n_b)))
+        self._mass_csr, self._rayleigh_csr = self.mass_matrix.tocsr(), self.rayleigh.tocsr()
+
+    def residual(self, y_b, p, shift_b) -> np.ndarray:
+        """The bulk's rows of the scaled step residual at the bulk unknowns ``y_b``, step data
+        ``p`` and stabilization shift ``shift_b``."""
+        n_b, n_u = self.n_b, self.n_u
+        u_pred, v_pred, b, t, bh2, gh, cm = step_data(p, n_u)
+        a = (y_b - u_pred[:n_b] - shift_b) / bh2
+        v = v_pred[:n_b] + gh * a
+        f = self._forces.nonzeros(y_b, v, t)[0]
+        return bh2 * (self._mass_csr @ (cm * a + b[:n_b]) + self._rayleigh_csr @ v - f)
+
+    def mass(self, q_f: np.ndarray) -> sps.csc_matrix:
+        """The mass matrix on the free coordinates at ``q_f``."""
+        m = to_scipy(self._mass_rest(q_f))
+        if self.n_b:
+            m = m + sps.block_diag([self.mass_matrix, sps.csc_matrix((self.n_f - self.n_b,) * 2)], format="csc")
+        return m.tocsc()
+
+    def set(self, y, p, shift) -> None:
+        """Factorize ``A`` at ``(y, p)`` (``shift``: the stabilization's shift of the step)."""
+        self._columns.clear()
+        self.bh2 = float(p[3 * self.n_u + 1])
+        self.factorizations += 1
+        if not self.n_b:
+            self.lu = True
+            return
+        a = self.jacobian.sparse(y[: self.n_b], p, shift[: self.n_b])[0]
+        try:
+            asymmetry = abs(a - a.T).max() if a.nnz else 0.0
+            if asymmetry <= 1e-12 * abs(a).max():
+                # A catenary's matrix is a narrow band after reordering: a banded Cholesky solves
+                # several times faster than SuperLU's LU (which it falls back to when not SPD)
+                self.lu = BandedCholesky(a, self._permutation)
+                self._permutation = self.lu.permutation  # same pattern at every refactorization
+            else:
+                self.lu = spla.splu(a.tocsc())
+        except RuntimeError:
+            raise SolverError("generalized-alpha: singular iteration matrix of the wires (an ANCF coordinate "
+                              "without mass or stiffness?)") from None
+
+    def valid_for(self, bh2: float) -> bool:
+        return self.lu is not None and self.bh2 == bh2
+
+    def solve(self, r: np.ndarray) -> np.ndarray:
+        return self.lu.solve(r) if self.n_b else r
+
+    def columns(self, index: np.ndarray) -> np.ndarray:
+        """``A^-1 e_i`` for each ``i`` of ``index`` (n_b x len(index))."""
+        out = np.empty((self.n_b, index.size))
+        missing = [i for i in index.tolist() if i not in self._columns]
+        if missing:
+            if len(self._columns) + len(missing) > MAX_COLUMNS:
+                self._columns.clear()
+                missing = index.tolist()
+            e = np.zeros((self.n_b, len(missing)))
+            e[missing, np.arange(len(missing))] = 1.0
+            for i, col in zip(missing, self.lu.solve(e).T):
+                self._columns[i] = col
+        for k, i in enumerate(index.tolist()):
+            out[:, k] = self._columns[i]
+        return out

@@ -1,0 +1,191 @@
+"""Multibody pantographs as scene fragments for a line passage (:mod:`.scene_passage`, whose
+docstring states the fragment contract): :class:`ScenePantograph`, the seed paper's and the
+lumped pantographs as fragments, and the static states that trim their uplift to a static
+contact force."""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..catenary.formfinding import FormFindingResult
+from ..errors import ParameterError, SolverError
+
+#: ``add(scene, wire, x0, speed, uplift) -> contact name`` (module docstring).
+PantographFragment = Callable[..., str]
+
+@dataclass
+class ScenePantograph:
+    """A pantograph scene fragment for :func:`run_scene_passage`.
+
+    Attributes
+    ----------
+    add : callable
+        ``add(scene, wire, x0, speed, uplift) -> contact name`` (module docstring); units m,
+        m/s, N.
+    uplift : float
+        First guess of the uplift (N) that gives the target static contact force.
+    name : str
+        Shown in plot titles and the summary.
+    description : str
+        One line about the model (plot titles).
+    """
+
+    add: PantographFragment
+    uplift: float = 100.0
+    name: str = "pantograph"
+    description: str = ""
+
+
+def seo2005_fragment(contact: str = "penalty", contact_stiffness: float = 5.0e4, contact_damping: float = 0.0,
+                     contact_smoothing: float = 1.0e-5, aero_force: float = 0.0, rod_stiffness: float = 5.0e5,
+                     prefix: str = "pantograph_") -> ScenePantograph:
+    """The seed paper's four-body pantograph (:func:`symcat.pantograph.add_seo2005_pantograph`)
+    as a :class:`ScenePantograph`.
+
+    Parameters
+    ----------
+    contact : {"penalty", "bilateral"}
+        Pan-head/wire contact (bilateral: a sliding joint, for an unstaggered wire only).
+    contact_stiffness, contact_damping, contact_smoothing : float
+        Penalty law (N/m, N s/m, m).
+    aero_force : float
+        Constant aerodynamic uplift (N) on the pan-head (``c v^2`` at the run's speed).
+    rod_stiffness : float
+        Coupling rod (N/m).
+    prefix : str
+        Before every element name.
+    """
+    from ..pantograph.seo2005 import add_seo2005_pantograph
+    from ..scene import PointLoad
+
+    def add(scene, wire, x0, speed, uplift):
+        names = add_seo2005_pantograph(scene, wire, x0, None, contact, None, speed, uplift, rod_stiffness,
+                                       contact_stiffness, contact_damping, contact_smoothing, prefix=prefix)
+        if aero_force:
+            scene.add(PointLoad(prefix + "aero", names["panhead"], force=(0.0, 0.0, float(aero_force))))
+        return names["contact"]
+
+    return ScenePantograph(add, uplift=265.0, name="seo2005",
+                           description="seo2005 four-body pantograph")
+
+
+def lumped_fragment(pantograph, contact: str = "penalty", contact_stiffness: float = 5.0e4,
+                    contact_damping: float = 0.0, contact_smoothing: float = 1.0e-5,
+                    form: FormFindingResult | None = None, name: str = "pantograph") -> ScenePantograph:
+    """A lumped-mass pantograph (:class:`~symcat.pantograph.LumpedPantograph`: its stages,
+    springs, dampers, uplift and aerodynamic force) as scene bodies
+    (:func:`symcat.pantograph.lumped_scene.add_lumped_pantograph`), a :class:`ScenePantograph`:
+    the interaction path's pantograph on the shared multibody path. The trimmed uplift replaces
+    ``pantograph.uplift``. With the catenary's ``form``, the pan-head is placed as the
+    interaction path places it (on the wire's static height under its static force,
+    :func:`~symcat.pantograph.lumped_scene.loaded_wire_height`), so that the nominal uplift gives
+    the static force and the trim takes one static solve. ``name`` prefixes its elements (two
+    pantographs on one line need two names)."""
+    from dataclasses import replace
+
+    from ..pantograph.lumped_scene import add_lumped_pantograph, loaded_wire_height
+
+    def add(scene, wire, x0, speed, uplift):
+        panto = replace(pantograph, uplift=float(uplift))
+        head_z = None if form is None else loaded_wire_height(form, x0, float(panto.static_force(speed).sum()))
+        info = add_lumped_pantograph(scene, panto, wire, x0, speed, contact=contact, contact_stiffness=contact_stiffness,
+                                     contact_damping=contact_damping, smoothing=contact_smoothing, head_z=head_z,
+                                     name=name)
+        return info["contact"]
+
+    return ScenePantograph(add, uplift=float(pantograph.uplift), name=f"{pantograph.name} (scene)",
+                           description=f"{pantograph.name} as scene bodies")
+
+
+def _contact_element(scene, name: str):
+    from ..scene import PenaltyContact, SlidingJoint
+
+    for e in scene.force_elements + scene.joints:
+        if e.name == name and isinstance(e, (PenaltyContact, SlidingJoint)):
+            return e
+    raise ParameterError(f"pantograph fragment: returned {name!r}, which is not a PenaltyContact or SlidingJoint of "
+                         "the scene; it must return the name of its pan-head/wire contact")
+
+
+def static_force(eq, element) -> float:
+    """Static contact force (N, pressing the pan-head down) of the contact ``element`` in the
+    equilibrium ``eq``: the penalty force, or minus the sliding joint's vertical reaction."""
+    from ..scene import PenaltyContact
+
+    if isinstance(element, PenaltyContact):
+        return float(eq.contact_force_N[element.name])
+    return -float(eq.reactions_N[element.name][2])
+
+
+def _static(form, pantographs, wire: str, positions, speed: float, uplifts):
+    """Scene, model, contact elements and equilibrium of the ``pantographs`` at ``positions``
+    (m) with ``uplifts`` (N)."""
+    from ..analysis.equilibrium import solve_equilibrium
+    from ..assembly.multibody import MultibodyModel
+    from ..catenary.scene import catenary_scene
+
+    scene = catenary_scene(form)
+    elements = [_contact_element(scene, panto.add(scene, wire, x0, speed, float(u)))
+                for panto, x0, u in zip(pantographs, positions, uplifts)]
+    model = MultibodyModel(scene)
+    eq = solve_equilibrium(model)
+    return scene, model, elements, eq
+
+
+def trim_uplifts(form, pantographs, target_force: float, wire: str, positions, speed: float,
+                 force_rtol: float = 1e-9, max_solves: int = 8):
+    """The uplifts (N) whose static contact forces are ``target_force`` (N), the ``pantographs``
+    standing at ``positions`` (m): two static solves (a pantograph's force is affine in its
+    uplift), then secant steps while a force is off by more than ``force_rtol`` relative (the
+    pantograph's geometry moves slightly with its height; several pantographs interact through
+    the wire, weakly, so each has its own secant).
+
+    Returns
+    -------
+    uplifts, forces, (scene, model, elements, eq), solves
+        The uplifts (N) and their static forces (N), lists in the order of ``pantographs``, the
+        static state built with them (``elements``: the contact of each) and the number of
+        static solves.
+    """
+    who = ("pantograph " if len(pantographs) == 1 else "pantographs ") + ", ".join(p.name for p in pantographs)
+
+    def text(values):
+        return "/".join(f"{v:g}" for v in values)
+
+    def done(f):
+        return np.abs(f - target_force).max() <= force_rtol * abs(target_force)
+
+    u0 = np.array([float(p.uplift) for p in pantographs])
+    built = _static(form, pantographs, wire, positions, speed, u0)
+    f0 = np.array([static_force(built[3], e) for e in built[2]])
+    solves = 1
+    u1 = u0 + (target_force - f0)  # unit sensitivity as the first guess (uplift at the pan-head)
+    while solves < max_solves and not done(f0):
+        built1 = _static(form, pantographs, wire, positions, speed, u1)
+        f1 = np.array([static_force(built1[3], e) for e in built1[2]])
+        solves += 1
+        if not np.all((f1 > 0) | (f0 > 0)):
+            raise ParameterError(f"{who}: no contact at uplifts {text(u0)} N and {text(u1)} N; give a first uplift "
+                                 "guess that presses the pan-head on the wire")
+        step = np.where(u1 != u0, u1 - u0, 1.0)
+        slope = np.where(u1 != u0, (f1 - f0) / step, 0.0)
+        if not np.all(slope > 0):
+            raise SolverError(f"{who}: the static contact force does not grow with the uplift ({text(f0)} N at "
+                              f"{text(u0)} N, {text(f1)} N at {text(u1)} N)")
+        u0, f0, built = u1, f1, built1
+        u1 = u1 + (target_force - f1) / slope
+    if done(f0):
+        return u0.tolist(), f0.tolist(), built, solves
+    raise SolverError(f"{who}: the uplift trim did not reach the static contact force {target_force:g} N in "
+                      f"{max_solves} static solves (last {text(f0)} N at {text(u0)} N uplift)")
+
+
+def trim_uplift(form, pantograph: ScenePantograph, target_force: float, wire: str, x0: float, speed: float,
+                force_rtol: float = 1e-9, max_solves: int = 8):
+    """:func:`trim_uplifts` of one pantograph at ``x0`` (m): ``uplift, force, (scene, model,
+    element, eq), solves``."""
+    u, f, (scene, model, elements, eq), solves = trim_uplifts(form, [pantograph], target_force, wire, [x0], speed,
+                                                              force_rtol, max_solves)
+    return u[0], f[0], (scene, model, elements[0], eq), solves
