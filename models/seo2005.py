@@ -37,7 +37,7 @@ from symcat.pantograph.seo2005 import PARAMETERS as PANTOGRAPH_PARAMETERS
 from symcat.pantograph.seo2005 import (B_DEPTH, G, MASSES, add_seo2005_pantograph_from, check_run, contact_history,
                                        static_contact_force, wire_atol)
 from symcat.scene import Scene
-from symcat.simulation import simulate
+from symcat.simulation import integrate_model, integrator_parameters
 from symcat.vehicle import VehicleParameters, add_vehicle, wheel_forces
 from symcat.wheelrail import PAIR_NAMES, profile_pair
 
@@ -61,6 +61,7 @@ PARAMETERS = [
               minimum=-0.008, maximum=0.008),
     Parameter("rtol", 1e-6, "-", "IDAS relative tolerance", minimum=1e-12, maximum=1e-2),
     Parameter("n_out", 200, "-", "output intervals per simulated second", minimum=10, maximum=100000),
+    *integrator_parameters(),
 ]
 
 
@@ -116,7 +117,7 @@ def run(p: dict) -> ModelOutput:
     try:
         settings = IdasSettings(rtol=p["rtol"], atol=wire_atol(model, p["rtol"] * 1e-2), n_out=n_out,
                                 progress=p.get("progress", True))
-        res = simulate(model, p["t_end"], "augmented", "ggl", settings)
+        res = integrate_model(model, p, p["t_end"], "augmented", "ggl", settings)
     except SolverError as err:
         raise SolverError(f"{err} (seo2005: vehicle, pantograph and catenary; try a tighter rtol)",
                           partial=err.partial) from err
@@ -165,7 +166,7 @@ def run(p: dict) -> ModelOutput:
         pvd = write_multibody_series(model, res.t_s, res.q, out / "paraview", "seo2005")
         return [npz, plot, pvd]
 
-    return ModelOutput(summary, {**{k: res.stats[k] for k in ("nsteps", "netfails", "nncfails")},
+    return ModelOutput(summary, {**{k: res.stats.get(k) for k in ("nsteps", "netfails", "nncfails", "newton_iterations")},
                                  "equilibrium": eq.stats()}, {"result": res, "equilibrium": eq, "layout": layout}, write)
 
 

@@ -72,7 +72,7 @@ from symcat.integrate import IdasSettings
 from symcat.integrate.settings import VELOCITY_ATOL_FACTOR
 from symcat.model import Model, ModelOutput, Parameter, existing_file
 from symcat.scene import Scene
-from symcat.simulation import simulate
+from symcat.simulation import integrate_model, integrator_parameters
 from symcat.vehicle import (DRIVES, VehicleParameters, add_vehicle, curve_track, lateral_displacement_m,
                             lateral_force_sum_N, momentum_rate_N, steady_curving_forces_N, wheel_forces)
 from symcat.wheelrail import PAIR_NAMES, profile_pair
@@ -118,6 +118,7 @@ PARAMETERS = [
               "the vehicle centre's start, m) and any of alignment_m, level_m, cross_level_m, gauge_m (m); empty: "
               "ideal track",
               text="the path of a CSV file, or nothing", check=existing_file),
+    *integrator_parameters(),
 ]
 
 #: Track beyond the outermost wheelsets on a tangent layout with irregularities (m).
@@ -215,14 +216,14 @@ def run(p: dict) -> ModelOutput:
         settings = IdasSettings(rtol=p["rtol"], atol=atol,
                                 velocity_atol=p.get("atol_velocity") or VELOCITY_ATOL_FACTOR * atol,
                                 n_out=int(p["n_out"]), progress=p.get("progress", True))
-        res = simulate(model, p["t_end"], index=p["index"], settings=settings)
+        res = integrate_model(model, p, p["t_end"], "augmented", p["index"], settings)
     except SolverError as err:
         hint = ("; cant_ramp=smooth (the ends of a linear cant ramp are kinks of the rails, impacts the rigid "
                 "contacts do not get past)") if p.get("cant_m", 0.0) > 0 and p.get("cant_ramp") == "linear" else ""
         raise SolverError(f"{err} (vehicle model: try index=ggl or a tighter rtol{hint}; a flange contact or a contact "
                           "jump may have been reached)", partial=err.partial) from err
     summary = summarize(res, layout)
-    stats = {k: res.stats[k] for k in ("nsteps", "nfevals", "nlinsetups", "netfails", "nncfails", "restarts",
+    stats = {k: res.stats.get(k) for k in ("nsteps", "nfevals", "nlinsetups", "netfails", "nncfails", "restarts",
                                        "contact_calls", "contact_jumps")}
 
     def write(out):

@@ -51,7 +51,7 @@ from symcat.integrate import IdasSettings
 from symcat.integrate.settings import VELOCITY_ATOL_FACTOR
 from symcat.model import Model, ModelOutput, Parameter, existing_file
 from symcat.scene import CreepModel, Driving, PointLoad, RigidBody, Scene, WheelRailJoint
-from symcat.simulation import simulate
+from symcat.simulation import integrate_model, integrator_parameters
 from symcat.vehicle import wheelset_on_track
 from symcat.wheelrail import PAIR_NAMES, WheelsetDimensions, profile_pair
 from symcat.wheelrail.track import Tangent, TrackLayout, rail_offset_for, read_irregularities
@@ -86,6 +86,7 @@ PARAMETERS = [
     Parameter("irregularity_file", "", "", "CSV of measured track irregularities: header s_m (from the start, m) and "
               "any of alignment_m, level_m, cross_level_m, gauge_m (m); empty: ideal track",
               text="the path of a CSV file, or nothing", check=existing_file),
+    *integrator_parameters(),
 ]
 
 #: Track behind the wheelset's start on a layout with irregularities (m): its contact points
@@ -166,7 +167,7 @@ def run(p: dict) -> ModelOutput:
         settings = IdasSettings(rtol=p["rtol"], atol=atol,
                                 velocity_atol=p.get("atol_velocity") or VELOCITY_ATOL_FACTOR * atol,
                                 n_out=int(p["n_out"]), progress=p.get("progress", True))
-        res = simulate(model, p["t_end"], formulation=p["formulation"], settings=settings)
+        res = integrate_model(model, p, p["t_end"], p["formulation"], "1", settings)
     except SolverError as err:
         raise SolverError(f"{err} (wheelset model: one constraint contact point per wheel, which jumps to the "
                           "lowest point of the gap; a free wheelset hunts, and at speed its flanges strike)",

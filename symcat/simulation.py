@@ -65,8 +65,8 @@ def integrate_model(model, p: dict, t_end: float, formulation: str, index: str, 
     Raises
     ------
     ParameterError
-        A combination that cannot run (generalized-alpha with the embedded form, or with
-        wheel/rail contacts), naming it and what is allowed.
+        A combination that cannot run (generalized-alpha with the embedded form), naming it
+        and what is allowed.
     """
     settings = settings_from(settings, **legacy)
     if p["integrator"] == "idas":
@@ -74,9 +74,5 @@ def integrate_model(model, p: dict, t_end: float, formulation: str, index: str, 
     if formulation != "augmented":
         raise ParameterError(f"formulation={formulation} with integrator=generalized_alpha: generalized-alpha "
                              "integrates the augmented form; use formulation=augmented, or integrator=idas")
-    contacts = [e.joint.name for e in model.wheelrail]
-    if contacts:
-        raise ParameterError(f"integrator=generalized_alpha: not yet with wheel/rail contacts "
-                             f"({', '.join(contacts)}); use integrator=idas")
     return generalized_alpha(model, t_end, p["dt"], p["rho_inf"], variant=ALPHA_VARIANTS[str(index)],
-                             n_out=settings.n_out, progress=settings.progress)
+                             n_out=settings.n_out, progress=settings.progress, handlers=default_handlers(model))

@@ -66,7 +66,8 @@ class Proxies:
             saved = [sl.window for sl in items]
             try:
                 proxy.install(w)
-                pattern = ca.Function("probe", [y, p, w], [step._rows(y, p)[0]]).sparsity_jac(0, 0)
+                mode = step.mode_symbol
+                pattern = ca.Function("probe", [y, p, w, mode], [step._rows(y, p, mode)[0]]).sparsity_jac(0, 0)
             finally:
                 model.element_override.clear()
                 for sl, window in zip(items, saved):

@@ -29,6 +29,8 @@ class AlphaRun:
     stats: dict = field(default_factory=dict)
     walls: list = field(default_factory=list)
     monitored: dict = field(default_factory=dict)
+    modes: list | None = None  # an event handler's open flags at each output
+    events: list = field(default_factory=list)
 
     def result(self, wall0: float | None = None, multipliers: str = "kkt") -> SimulationResult:
         """The :class:`SimulationResult` of these outputs (as :func:`simulate` returns it);
@@ -39,7 +41,8 @@ class AlphaRun:
         if multipliers == "integrator":
             zb = self.form.blocks()[1]
             given = (np.asarray(self.zs, float).reshape(n, -1)[:, zb["a"].slice], self.multipliers[:n])
-        res = collect_result(self.form, self.t_s[:n], self.xs, self.zs, self.stats, wall0, [()] * n, [],
+        modes = self.modes[:n] if self.modes is not None else [()] * n
+        res = collect_result(self.form, self.t_s[:n], self.xs, self.zs, self.stats, wall0, modes, self.events,
                              self.walls, given)
         res.monitored = {key: np.asarray(values) for key, values in self.monitored.items()}
         return res

@@ -18,6 +18,11 @@ ANCF coordinates of the elements a contact can currently touch (its element wind
   rest's exact Jacobian through a Woodbury (capacitance) update on the few unknowns it touches,
   with the columns ``A^-1 e_i`` of those unknowns cached while the contact stays on an element.
 
+When the wires are not the larger part of the unknowns (the seed paper's 8-element wire under
+its vehicle, or no wire at all) the whole step matrix is factorized instead (sparse LU), and a
+rest of many unknowns keeps its factorization over the steps while Newton converges fast
+(:meth:`StepEquations.keeps_coupling`).
+
 This is how dedicated pantograph/catenary codes keep a constant iteration matrix while the
 contact point moves; refactorizing a 7,000-unknown line whenever the contact crosses an element,
 or differentiating the whole graph, costs more than the rest of the step many times over.
@@ -28,13 +33,21 @@ import casadi as ca
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sps
+import scipy.sparse.linalg as spla
 
+from ..assembly.wheelrail import has_creep
 from ..codegen.library import BufferedFunction, symbolic_kernels
 from ..dae.formulation import Formulation
 from ..errors import SolverError
 from .alpha_bulk import Bulk, step_data
 from .alpha_proxies import Proxies, move_back
 
+#: Unknowns of the rest above which its capacitance is factorized sparse (a vehicle's bodies,
+#: joints and contacts: hundreds of unknowns, a few nonzeros per row) instead of dense.
+DENSE_CAPACITANCE = 200
+#: A kept coupling (:meth:`StepEquations.keeps_coupling`) is prepared afresh after a step that
+#: took more Newton iterations than this.
+KEPT_ITERATIONS = 2
 #: A Newton iteration that contracts by less than this per iteration updates its matrix.
 SLOW_CONTRACTION = 0.3
 
@@ -64,8 +77,11 @@ class StepEquations:
         self.bulk = bulk if bulk is not None else Bulk(form, n_u, expand)
         y = ca.MX.sym("y", n_y)
         p = ca.MX.sym("p", 3 * n_u + 4)
-        self.proxies = Proxies.choose(self, y, p) if proxies else None
         model = form.model
+        # The open flags of the wheel/rail contacts (1: lifted off), set by an event handler.
+        self.mode = np.zeros(len(model.wheelrail))
+        self.mode_symbol = mode = ca.MX.sym("mode", self.mode.size)
+        self.proxies = Proxies.choose(self, y, p) if proxies else None
         saved = [sl.window for sl in model.windowed()]
         w = ca.MX.sym("w", 0 if self.proxies is None else 2 * len(self.proxies.items))
         try:
@@ -73,7 +89,7 @@ class StepEquations:
                 self.proxies.install(w)
             # The rest depends on few unknowns: entered as a structurally sparse y, its graph and
             # Jacobian never touch the other thousands.
-            pattern = ca.Function("alpha_rest", [y, p, w], [self._rows(y, p)[0]]).sparsity_jac(0, 0)
+            pattern = ca.Function("alpha_rest", [y, p, w, mode], [self._rows(y, p, mode)[0]]).sparsity_jac(0, 0)
             self.rest_columns = np.unique(np.array(pattern.get_col(), int))
             k = self.rest_columns.size
             y_rest = ca.MX.sym("y_rest", k)
@@ -81,33 +97,39 @@ class StepEquations:
             # Built on the kernels' SX forms and expanded: as scalar operations the rest's
             # Jacobian evaluates some 30 times faster than through the MX graph.
             with symbolic_kernels():
-                rest = ca.Function("alpha_rest", [y_rest, p, w], list(self._rows(y_sparse, p, contacts=True)))
+                rest = ca.Function("alpha_rest", [y_rest, p, w, mode], list(self._rows(y_sparse, p, mode, contacts=True)))
         finally:
             model.element_override.clear()
             for sl, window in zip(model.windowed(), saved):
                 sl.window = window
-        try:
-            rest = rest.expand()
-            y_rest, p, w = rest.sx_in()
-        except RuntimeError:  # a kernel without an SX form: the MX graph
-            y_rest, p, w = rest.mx_in()
-        r_rest = rest(y_rest, p, w)[0]
+        rest, jac = _expanded_rest(rest)
         self._rest = BufferedFunction(rest)
         # the outputs are sparse (most rows belong to the bulk): their nonzeros' places
         self._r_rows = np.array(rest.sparsity_out(0).row(), int)
         self._shift_rows = np.array(rest.sparsity_out(1).row(), int)
-        jac = ca.Function("alpha_rest_jacobian", [y_rest, p, w], [ca.jacobian(r_rest, y_rest)])
         self._rest_jacobian = BufferedFunction(jac)
         colind, row = jac.sparsity_out(0).get_ccs()
         self._jac_rows = np.array(row, int)
         self._jac_cols = self.rest_columns[np.repeat(np.arange(k), np.diff(colind))]
         self.mass_scale = mass_scale  # kg: mean diagonal of M, converts multiplier updates to positions
+        # Few wire unknowns against the rest (the seed's 8-element wire under a vehicle, or no
+        # wire): the whole step matrix is factorized (sparse LU) instead of corrected by a
+        # Woodbury update, whose capacitance is then as large as the system and, with the
+        # stiff cross-section gradients of beam3d wires, too ill-conditioned to solve accurately.
+        self.direct = self.bulk.n_b <= self.n_y - self.bulk.n_b
         self._coupling = None
+        # (beta h^2, open flags) of a sparse capacitance that later steps may keep (see
+        # :meth:`keeps_coupling`), else None.
+        self._prepared = None
+        self.last_iterations = 0
 
-    def _rows(self, y, p, contacts: bool = False):
+    def _rows(self, y, p, mode, contacts: bool = False):
         """The rest's scaled residual rows and the stabilization's shift ``G^T nu`` at ``(y,
         p)``: the step residual without the bulk's mass and forces (with ``contacts``, also the
-        penalty contacts' gaps and normal forces)."""
+        penalty contacts' gaps and normal forces). The wheel/rail contacts' creep forces depend
+        on their normal forces (the multipliers ``lambda = y_lambda / (beta h^2)``); an open
+        contact (``mode`` 1) has its gap rows replaced by its multipliers, as in the DAE
+        (:meth:`Formulation.dae`)."""
         form, variant = self.form, self.variant
         n_f, n_s, n_c, n_sc, n_u, n_y = form.n_f, self.n_s, self.n_c, self.n_sc, self.n_u, self.n_y
         u_pred, v_pred, b, t, bh2, gh, cm = step_data(p, n_u)
@@ -124,10 +146,14 @@ class StepEquations:
         v = v_pred + gh * a
         v_dot = cm * a + b
         k = self._terms(form, q, v[:n_f], s, v[n_f:], t, sc)
-        rows = [bh2 * (ca.mtimes(k["M"], v_dot[:n_f]) - k["Q"]) + ca.mtimes(k["Cq"].T, lam_s),
-                ca.mtimes(k["Cs"].T, lam_s), k["C"]]
+        dyn = ca.mtimes(k["M"], v_dot[:n_f]) - k["Q"]
+        if has_creep(form.model):
+            dyn -= form.creep_force(k, s, v[n_f:], lam_s / bh2)[0]
+        rows = [bh2 * dyn + ca.mtimes(k["Cq"].T, lam_s), ca.mtimes(k["Cs"].T, lam_s),
+                form._release(k["C"], lam_s, mode)]
         if variant == "stabilized":
-            rows.append(bh2 / gh * (ca.mtimes(k["Cq"], v[:n_f]) + ca.mtimes(k["Cs"], v[n_f:]) + k["Ct"]))
+            c_dot = bh2 / gh * (ca.mtimes(k["Cq"], v[:n_f]) + ca.mtimes(k["Cs"], v[n_f:]) + k["Ct"])
+            rows.append(form._release(c_dot, nu, mode))
         rows.append(k["T"])
         if contacts:
             return ca.vertcat(*rows), shift, k["gap"], k["fc"]
@@ -144,14 +170,14 @@ class StepEquations:
     def _inputs(self, y, p):
         """The rest's inputs at ``(y, p)`` and the proxies' maps (None without proxies)."""
         if self.proxies is None:
-            return y[self.rest_columns], p, np.zeros(0), None
+            return y[self.rest_columns], p, np.zeros(0), self.mode, None
         y2, p2, w, maps = self.proxies.substitute(y, p)
-        return y2[self.rest_columns], p2, w, maps
+        return y2[self.rest_columns], p2, w, self.mode, maps
 
     def _rest_values(self, y, p):
         """The rest's residual (n_y) and shift (n_u) at ``(y, p)``, dense."""
-        y_rest, p_in, w, maps = self._inputs(y, p)
-        r_nz, shift_nz, *_ = self._rest.nonzeros(y_rest, p_in, w)
+        y_rest, p_in, w, mode, maps = self._inputs(y, p)
+        r_nz, shift_nz, *_ = self._rest.nonzeros(y_rest, p_in, w, mode)
         r, shift = np.zeros(self.n_y), np.zeros(self.n_u)
         r[self._r_rows] = r_nz
         shift[self._shift_rows] = shift_nz
@@ -177,8 +203,8 @@ class StepEquations:
         if self.n_sc:
             y[self.n_y - self.n_sc :] = sc
         p = np.r_[u, v, np.zeros(n_u), t, 1.0, 1.0, 1.0]
-        y_rest, p_in, w, _ = self._inputs(y, p)
-        _, _, gap, force = self._rest.nonzeros(y_rest, p_in, w)
+        y_rest, p_in, w, mode, _ = self._inputs(y, p)
+        _, _, gap, force = self._rest.nonzeros(y_rest, p_in, w, mode)
         return gap, force
 
     def update(self, y, p) -> tuple:
@@ -196,8 +222,8 @@ class StepEquations:
         """The rest's exact Jacobian as (rows, columns, values), nonzero values only, with the
         bulk rows' dependence on ``nu`` through the shift of ``a`` under the stabilized form:
         ``-(c_m M + gamma h C) G^T`` with the constant bulk mass and Rayleigh matrices."""
-        y_rest, p_in, w, maps = self._inputs(y, p)
-        values = self._rest_jacobian.nonzeros(y_rest, p_in, w)[0]
+        y_rest, p_in, w, mode, maps = self._inputs(y, p)
+        values = self._rest_jacobian.nonzeros(y_rest, p_in, w, mode)[0]
         keep = values != 0
         rows, cols, data = self._jac_rows[keep], self._jac_cols[keep], values[keep]
         if maps is not None:  # the proxies' rows and columns are those of the actual elements
@@ -242,7 +268,10 @@ class StepEquations:
             # on the stiff cross-section gradients of a beam3d wire exceeds the mass by orders.
             diag = np.abs(self.mass(y).diagonal())
             self.mass_scale = float(diag.mean()) if diag.size and diag.mean() > 0 else 1.0
-        self.bulk.set(y, p, self._rest_values(y, p)[1])
+        if self.direct:  # prepare factorizes everything
+            self.bulk.lu, self.bulk.bh2 = True, float(p[3 * self.n_u + 1])
+        else:
+            self.bulk.set(y, p, self._rest_values(y, p)[1])
         self.prepare(y, p)
 
     def prepare(self, y, p) -> None:
@@ -250,6 +279,14 @@ class StepEquations:
         touches (every non-bulk unknown and the bulk ones in a nonzero row or column), the
         columns ``Z = P^-1 E_K`` (``P`` = bulk matrix, identity elsewhere), and the factorized
         capacitance ``I + Delta Z_K`` with ``Delta = J_rest[K, K] - I`` on the non-bulk part."""
+        if self.direct:
+            try:
+                self._coupling = spla.splu(self.jacobian(y, p))
+            except RuntimeError:
+                raise SolverError(_SINGULAR) from None
+            self.bulk.factorizations += 1
+            self._prepared = (float(p[3 * self.n_u + 1]), self.mode.copy())
+            return
         n_b, n_y = self.bulk.n_b, self.n_y
         r_i, c_i, data = self._rest_triplets(y, p)
         touched = np.unique(np.concatenate([r_i[r_i < n_b], c_i[c_i < n_b]]))
@@ -257,11 +294,24 @@ class StepEquations:
         pos = np.full(n_y, -1)
         pos[keys] = np.arange(keys.size)
         k = keys.size
+        n_t = touched.size
+        z_bulk = self.bulk.columns(touched) if n_t else np.zeros((n_b, 0))
+        if k > DENSE_CAPACITANCE:
+            # Bodies with many coordinates (a vehicle on a line): the capacitance is the rest's
+            # sparse Jacobian but for the block of the touched wire unknowns.
+            delta = sps.csr_matrix((data, (pos[r_i], pos[c_i])), shape=(k, k))
+            delta = (delta - sps.diags(np.r_[np.zeros(n_t), np.ones(k - n_t)])).tocsr()
+            z_k = sps.block_diag([sps.csr_matrix(z_bulk[touched]), sps.identity(k - n_t)], format="csr")
+            try:
+                cap = spla.splu((sps.identity(k) + delta @ z_k).tocsc())
+            except RuntimeError:
+                raise SolverError(_SINGULAR) from None
+            self._coupling = (keys, n_t, delta, z_bulk, cap)
+            self._prepared = (float(p[3 * self.n_u + 1]), self.mode.copy())
+            return
         delta = np.zeros((k, k))
         np.add.at(delta, (pos[r_i], pos[c_i]), data)
-        n_t = touched.size
         delta[n_t:, n_t:] -= np.eye(k - n_t)
-        z_bulk = self.bulk.columns(touched) if n_t else np.zeros((n_b, 0))
         z_k = np.eye(k)
         if n_t:
             z_k[:n_t, :n_t] = z_bulk[touched]
@@ -272,17 +322,45 @@ class StepEquations:
         if np.any(np.diag(cap[0]) == 0):
             raise SolverError(_SINGULAR)
         self._coupling = (keys, n_t, delta, z_bulk, cap)
+        self._prepared = None
+
+    def keeps_coupling(self, p) -> bool:
+        """Whether the next step may keep the rest's coupling prepared at an earlier step: a
+        rest of many unknowns (:data:`DENSE_CAPACITANCE`, or a step matrix factorized whole: a
+        vehicle's bodies and contacts, whose Jacobian and sparse factorization cost several
+        residuals and change little from step to step), the same step size and open contacts, and a last step that converged in
+        at most :data:`KEPT_ITERATIONS` iterations. A rest of a few pantograph unknowns on a
+        line is prepared every step: its contact crosses elements, and a kept coupling cost
+        more iterations than it saved."""
+        if self._prepared is None or self.last_iterations > KEPT_ITERATIONS:
+            return False
+        bh2, mode = self._prepared
+        return bh2 == float(p[3 * self.n_u + 1]) and np.array_equal(mode, self.mode)
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
-        """``J^-1 rhs`` with ``J = P + E_K Delta E_K^T`` (Woodbury)."""
+        """``J^-1 rhs`` with ``J = P + E_K Delta E_K^T`` (Woodbury), or by the factorized ``J``."""
+        if self.direct:
+            return self._coupling.solve(rhs)
         keys, n_t, delta, z_bulk, cap = self._coupling
         n_b = self.bulk.n_b
         x = rhs.copy()
         x[:n_b] = self.bulk.solve(rhs[:n_b])
-        w = sla.lu_solve(cap, delta @ x[keys])
+        w = cap.solve(delta @ x[keys]) if isinstance(cap, spla.SuperLU) else sla.lu_solve(cap, delta @ x[keys])
         x[:n_b] -= z_bulk @ w[:n_t]
         x[n_b:] -= w[n_t:]
         return x
+
+
+def _expanded_rest(rest: ca.Function) -> tuple[ca.Function, ca.Function]:
+    """The rest's function (built on the kernels' SX forms) expanded to scalar operations, and
+    its Jacobian in the unknowns; the MX graph if a kernel has no SX form."""
+    try:
+        rest = rest.expand()
+        args = rest.sx_in()
+    except RuntimeError:
+        args = rest.mx_in()
+    jac = ca.Function("alpha_rest_jacobian", args, [ca.jacobian(rest(*args)[0], args[0])])
+    return rest, jac
 
 
 def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: bool = False):
@@ -304,13 +382,14 @@ def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: 
     if not st.bulk.valid_for(bh2) or st.mass_scale is None:
         st.factorize(y, p)
         fresh = True
-    elif not refreshed:
+    elif not refreshed and not st.keeps_coupling(p):
         st.prepare(y, p)
     scale = np.full_like(y, tol)
     scale[n_u : n_u + n_c] = tol * st.mass_scale
     previous = None
     slow = 0
-    for _ in range(max_iterations):
+    st.last_iterations = max_iterations + 1  # unless it converges
+    for iteration in range(max_iterations):
         r = st.residual(y, p)
         dy = st.solve(-r)
         y += dy
@@ -320,6 +399,7 @@ def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: 
         if not np.isfinite(err):
             return None
         if err <= 1.0 and theta < 1.0 and theta / (1.0 - theta) * err <= 1.0 or err <= 1e-3:
+            st.last_iterations = iteration + 1
             return (y, *st.update(y, p))
         if previous is not None and theta > SLOW_CONTRACTION:
             if fresh and theta >= 1.0:

@@ -101,9 +101,15 @@ class EventStepper:
         The IDAS statistics summed.
     handler : EventHandler
         Attached to ``form`` and ``stats`` (:meth:`~.events.EventHandler.attach`).
+    calls : object, optional
+        Another integrator behind the calls: an object whose ``call(x, z, t_a, h, inner,
+        free)`` does what :meth:`call` does (e.g. generalized-alpha,
+        :class:`.alpha_calls.AlphaCalls`); ``dae_fn`` and the IDAS options are then unused but
+        for the tolerances in ``opts`` that the handler's :meth:`~.events.EventHandler.start`
+        receives.
     """
 
-    def __init__(self, form, dae_fn, opts: dict, x, z, stats: dict, stat_keys, handler):
+    def __init__(self, form, dae_fn, opts: dict, x, z, stats: dict, stat_keys, handler, calls=None):
         self.form = form
         self.stats = stats
         self.stat_keys = stat_keys
@@ -117,7 +123,10 @@ class EventStepper:
         # A call is at most one output interval: this many steps mean a singularity (a fold
         # passed unnoticed), and the retry, shorter and after an event check, beats waiting.
         self.opts["max_num_steps"] = min(int(opts.get("max_num_steps", MAX_CALL_STEPS)), MAX_CALL_STEPS)
-        self.set_dae(dae_fn)
+        if calls is None:
+            self.set_dae(dae_fn)
+        else:
+            self.call = calls.call
         self.step_hint = None  # IDAS's last step in the last call (s), see _first_step
         self.idas_said: list[str] = []  # IDAS's last message on a failed call
         self._start = None  # (t, x_dot) at the last call's start, see _first_step

@@ -39,7 +39,11 @@ Two variants (``variant``):
 Penalty contacts (:class:`symcat.scene.PenaltyContact`) add their arc lengths ``s_c`` as
 algebraic unknowns of each step with their tangency equations ``0 = T(q, s_c)`` (no multiplier;
 the normal forces are part of ``Q``), as in :class:`~symcat.dae.Formulation`. Wheel/rail contacts
-are not handled yet.
+are constraints like any other (their surface parameters among the zero-mass ``s``, their creep
+forces in ``Q`` as functions of the multipliers and of ``s_dot``, an open contact's gap rows
+replaced by its multipliers); their events (contact-point jumps, lift-off, touchdown) are decided
+between steps by the same :class:`~.events.EventHandler` as under IDAS, the steps running inside
+the calls of the event driver (:mod:`.alpha_events`).
 
 The Newton iteration solves for ``y = [u_{n+1}, beta h^2 lambda_{n+1} (, nu_{n+1}), s_c]`` with the
 scaling of Bottasso, Bauchau and Cardona (2007, "Time-step-size-independent conditioning and
@@ -87,8 +91,9 @@ from ..run_control import check_interrupt, ended_early, integrating
 from .alpha_coefficients import AlphaCoefficients
 from .alpha_run import AlphaRun, StepState
 from .alpha_step import StepEquations, solve_step
+from .alpha_events import integrate_alpha_events
 from .results import SimulationResult
-from .simulate import update_windows
+from .simulate import one_handler, update_windows
 
 VARIANTS = ("index3", "stabilized")
 
@@ -129,6 +134,8 @@ class _Integrator:
         self.tol, self.max_iterations, self.max_halvings, self.expand = tol, max_iterations, max_halvings, expand
         self.stats = stats
         self.xb, self.zb = form.blocks()
+        self.open_rows = []  # the constraint rows an event handler released (lifted wheels)
+        self.singular_fails_step = False  # a singular iteration matrix: a failed step, not the run's end
         self.stepper = self._build()
 
     def _build(self, previous: StepEquations | None = None) -> StepEquations:
@@ -167,7 +174,14 @@ class _Integrator:
         """One step of size ``h`` from ``s`` at ``t0``; None if its Newton iteration fails."""
         st = self.stepper
         p = self.data(s, t0, h)
-        done = solve_step(st, self.predictor(s, p, h), p, self.tol, self.max_iterations, self.stats)
+        try:
+            done = solve_step(st, self.predictor(s, p, h), p, self.tol, self.max_iterations, self.stats)
+        except SolverError:
+            if not self.singular_fails_step:
+                raise
+            # Under events (a contact point nearing a fold of its gap, where its constraint
+            # rows lose rank): a shorter step, or the event driver's recovery, gets past it.
+            return None
         if done is None:
             return None
         y, a, v, v_dot = done
@@ -232,6 +246,16 @@ class _Integrator:
         s.prev = (s.a, lam, sc)
         return s
 
+    def restart(self, x, z, h: float) -> _State:
+        """The state of ``(x, z)`` (consistent, e.g. just changed by an event) with ``a =
+        v_dot``: an event is a discontinuity, across which the method restarts at order 1."""
+        xb, zb = self.xb, self.zb
+        v_dot = np.r_[z[zb["a"].slice], z[zb["s_dd"].slice]]
+        lam = z[zb["lambda"].slice].copy()
+        sc = z[zb["sc"].slice].copy() if "sc" in zb else np.zeros(0)
+        return _State(np.r_[x[xb["q"].slice], x[xb["s"].slice]], np.r_[x[xb["v"].slice], x[xb["w"].slice]], v_dot,
+                      v_dot.copy(), lam, sc, (v_dot, lam, sc), h)
+
     def starting_acceleration(self, s: _State, x, z, h: float) -> np.ndarray:
         """``a_0 = v_dot(t_0 + Delta)``, ``Delta = (alpha_m - alpha_f) h``: ``a_n`` approximates
         ``v_dot`` at ``t_n + Delta`` to O(h^2) (Arnold and Brüls 2007), and starting it from
@@ -260,7 +284,7 @@ class _Integrator:
         start = {"q": part["q"] + shift * part["v"] + 0.5 * shift**2 * acc["q"], "v": part["v"] + shift * acc["q"],
                  "s": part["s"] + shift * part["w"] + 0.5 * shift**2 * acc["s"], "w": part["w"] + shift * acc["s"],
                  "sc": s.sc}
-        z1 = consistent_state(form, shift, start=start, positions=False)[1]
+        z1 = consistent_state(form, shift, start=start, positions=False, open_rows=self.open_rows)[1]
         delta = np.r_[z1[zb["a"].slice], z1[zb["s_dd"].slice]] - s.v_dot
         st = self.stepper
         n_u, n_c, n_sc, n_f = st.n_u, st.n_c, st.n_sc, form.n_f
@@ -281,7 +305,8 @@ class _Integrator:
 
 def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: float = 0.9,
                     variant: str = "stabilized", tol: float = 1e-10, max_iterations: int = 20, n_out: int = 200,
-                    progress: bool = True, expand: bool = False, max_halvings: int = 4, monitor=None) -> AlphaRun:
+                    progress: bool = True, expand: bool = False, max_halvings: int = 4, monitor=None,
+                    handlers=None) -> AlphaRun:
     """Integrate ``model`` from its consistent initial state to ``t_end`` with fixed steps.
 
     Parameters are those of :func:`generalized_alpha`.
@@ -306,12 +331,21 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
         raise ParameterError(f"max_iterations={max_iterations!r}: must be >= 1")
     if not (isinstance(max_halvings, int) and 0 <= max_halvings <= 20):
         raise ParameterError(f"max_halvings={max_halvings!r}: must be an integer in 0..20")
-    if model.wheelrail:
-        raise ParameterError("generalized-alpha does not handle wheel/rail contacts yet; use simulate() (IDAS) for "
-                             "this model")
+    handler = one_handler(model, handlers)
+    if handler is not None and monitor is not None:
+        raise ParameterError("monitor: not with event handlers (the steps inside the event driver's calls are not "
+                             "recorded one by one); use the outputs (n_out)")
     wall0 = time.perf_counter()
     model.center_windows()
     form = Formulation(model, "augmented", "1")
+    if handler is not None:
+        stats = {"steps": 0, "nsteps": 0, "newton_iterations": 0, "factorizations": 0, "rebuilds": 0, "halvings": 0,
+                 "build_s": 0.0, "dt": dt, "rho_inf": coef.rho_inf, "variant": variant, "restarts": 0}
+        integ = _Integrator(model, form, coef, variant, tol, int(max_iterations), max_halvings, expand, stats)
+        try:
+            return integrate_alpha_events(integ, form, handler, t_end, dt, int(n_out), tol, progress, wall0)
+        finally:
+            stats["factorizations"] = integ.stepper.bulk.factorizations
     x, z = consistent_state(form, 0.0)
     # Equal steps no longer than dt, a whole number of them per output interval.
     n_steps = max(1, math.ceil(t_end / dt - 1e-9))
@@ -381,7 +415,7 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
 def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: float = 0.9,
                       variant: str = "stabilized", tol: float = 1e-10, max_iterations: int = 20, n_out: int = 200,
                       progress: bool = True, expand: bool = False, max_halvings: int = 4,
-                      multipliers: str = "kkt", monitor=None) -> SimulationResult:
+                      multipliers: str = "kkt", monitor=None, handlers=None) -> SimulationResult:
     """Simulate ``model`` from 0 to ``t_end`` seconds by the generalized-alpha method (fixed step).
 
     Parameters
@@ -431,6 +465,12 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
         stacked over the steps in ``result.monitored`` (with ``t_s``). What a passage records at
         every step (a contact force, a few heights) without a full output per step, whose
         post-processing (energies, every contact over the whole wire) costs more than the step.
+        Not with ``handlers``.
+    handlers : sequence of EventHandler, optional
+        Events between the steps (:mod:`.events`; one handler for now), required for a model
+        with wheel/rail contacts (:func:`symcat.simulation.integrate_model` attaches them): the
+        run then goes through the event-stepping driver, generalized-alpha steps inside its
+        calls (:mod:`.alpha_events`), with outputs every ``t_end / n_out``.
 
     Returns
     -------
@@ -456,7 +496,7 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
     try:
         with threadpool_limits(limits=1, user_api="blas"):
             run = integrate_alpha(model, t_end, dt, rho_inf, variant, tol, max_iterations, n_out, progress, expand,
-                                  max_halvings, monitor)
+                                  max_halvings, monitor, handlers)
     except SolverError as err:
         if isinstance(err.partial, AlphaRun):
             err.partial = err.partial.result(wall0, multipliers)

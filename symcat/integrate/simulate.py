@@ -81,7 +81,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     settings = settings_from(settings, **legacy)
     if not t_end > 0:
         raise ParameterError(f"t_end={t_end}: must be > 0 s")
-    handler = _one_handler(model, handlers)
+    handler = one_handler(model, handlers)
     rtol, n_out, chunks, max_step = settings.rtol, settings.n_out, settings.chunks, settings.max_step
     wall0 = time.perf_counter()
     form = Formulation(model, formulation, index, settings.baumgarte, settings.cholesky)
@@ -224,7 +224,7 @@ def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented"
     return collect_result(form, t_grid, xs, zs, stats, wall0, modes, events, walls)
 
 
-def _one_handler(model, handlers) -> EventHandler | None:
+def one_handler(model, handlers) -> EventHandler | None:
     """The run's event handler, checked: one or none, and one for a model with wheel/rail
     contacts (whose DAE takes their open flags as parameters)."""
     handlers = list(handlers or [])

@@ -61,10 +61,13 @@ def test_a_combination_that_cannot_run_is_one_line(model, values, message, capsy
         run_model(model, {**values, "integrator": "generalized_alpha", "t_end": 0.01})
 
 
-def test_wheel_rail_contacts_are_refused_by_generalized_alpha_with_their_names():
+def test_wheel_rail_contacts_run_on_generalized_alpha_with_their_event_handler():
     from symcat.simulation import integrate_model
     from tests.codegen.test_model_dae import _wheelset
 
     p = {"integrator": "generalized_alpha", "dt": 1e-3, "rho_inf": 0.9}
-    with pytest.raises(ParameterError, match=r"not yet with wheel/rail contacts \(wr_left, wr_right\)"):
-        integrate_model(_wheelset(), p, 0.01, "augmented", "ggl")
+    res = integrate_model(_wheelset(), p, 0.01, "augmented", "ggl", n_out=2, progress=False)
+    assert res.t_s[-1] == pytest.approx(0.01) and res.stats["steps"] == 10
+    assert res.stats["contact_calls"] >= 1  # through the event driver, the contact handler attached
+    with pytest.raises(ParameterError, match=r"formulation=embedded with integrator=generalized_alpha"):
+        integrate_model(_wheelset(), p, 0.01, "embedded", "1")
