@@ -62,13 +62,21 @@ def compiled_dae(build: Callable[[], ca.Function]) -> ca.Function:
 def model_library(build: Callable[[], ca.Function], fn: ca.Function, mode: str | None = None) -> Path:
     """Path of the compiled library of the DAE ``fn = build()`` (see :func:`compiled_dae`),
     compiling what ``mode`` (default: ``$SYMCAT_OPTIMIZE``, :mod:`.optimized`) asks for."""
-    mode = optimize_mode() if mode is None else mode
     name = fn.name()
     # The graph over the externals names each kernel library by its content-addressed path:
     # its serialization identifies the model without deriving anything.
-    key = fn.serialize().encode() + LAYOUT
-    plain = cached_library(f"model_{name}", key, FLAGS)
-    optimized = cached_library(f"model_{name}", key, OPTIMIZED_FLAGS)
+    return compiled_library(f"model_{name}", fn.serialize().encode() + LAYOUT,
+                            lambda folder: write_dae_c(build, name, folder), mode)
+
+
+def compiled_library(name: str, key: bytes, write_c: Callable[[Path], Path], mode: str | None = None) -> Path:
+    """Path of the cached library ``name`` identified by ``key``, compiled from the C that
+    ``write_c(folder)`` writes (returning its path) when the library is not cached yet: -O0
+    first and optimized in the background, or optimized now, or -O0 only (``mode``, default
+    ``$SYMCAT_OPTIMIZE``, :mod:`.optimized`)."""
+    mode = optimize_mode() if mode is None else mode
+    plain = cached_library(name, key, FLAGS)
+    optimized = cached_library(name, key, OPTIMIZED_FLAGS)
     if mode != "off" and optimized.exists():
         return optimized
     target, flags = (optimized, OPTIMIZED_FLAGS) if mode == "now" else (plain, FLAGS)
@@ -76,9 +84,9 @@ def model_library(build: Callable[[], ca.Function], fn: ca.Function, mode: str |
         t0 = time.perf_counter()
         with tempfile.TemporaryDirectory() as tmp:
             notice(f"compiling this model's equations with the C compiler (once per machine and model; cached in {target.parent})")
-            c_path = write_dae_c(build, name, Path(tmp))
+            c_path = write_c(Path(tmp))
             if mode == "now":
-                log.info("compiling the model's DAE optimized (about 30 s for the seed vehicle)")
+                log.info("compiling %s optimized (about 30 s for the seed vehicle's DAE)", name)
             build_library(find_compiler(), flags, c_path, target)
             if mode == "background" and not optimized.exists():
                 atomic_write(source_path(optimized), c_path.read_bytes())
@@ -87,6 +95,20 @@ def model_library(build: Callable[[], ca.Function], fn: ca.Function, mode: str |
     if mode == "background" and source_path(optimized).exists():  # also a job that died
         start_background(optimized)
     return target
+
+
+def write_functions_c(functions, name: str, folder: Path) -> Path:
+    """Generate the C of the SX ``functions`` into ``folder/<name>.c`` (its path)."""
+    cwd = os.getcwd()
+    os.chdir(folder)  # CasADi writes relative to the working directory
+    try:
+        gen = ca.CodeGenerator(f"{name}.c", {"with_header": False, "verbose": False})
+        for fn in functions:
+            gen.add(fn)
+        gen.generate()
+    finally:
+        os.chdir(cwd)
+    return folder / f"{name}.c"
 
 
 def write_dae_c(build: Callable[[], ca.Function], name: str, folder: Path) -> Path:
@@ -112,13 +134,4 @@ def write_dae_c(build: Callable[[], ca.Function], name: str, folder: Path) -> Pa
     jac = merged(sx.jacobian())
     log.info("compiling the model's DAE (%d operations) and its Jacobian (%d)", sx.n_instructions(),
              jac.n_instructions())
-    cwd = os.getcwd()
-    os.chdir(folder)  # CasADi writes relative to the working directory
-    try:
-        gen = ca.CodeGenerator(f"model_{name}.c", {"with_header": False, "verbose": False})
-        gen.add(sx)
-        gen.add(jac)
-        gen.generate()
-    finally:
-        os.chdir(cwd)
-    return folder / f"model_{name}.c"
+    return write_functions_c([sx, jac], f"model_{name}", folder)

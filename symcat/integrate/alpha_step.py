@@ -29,6 +29,8 @@ or differentiating the whole graph, costs more than the rest of the step many ti
 """
 from __future__ import annotations
 
+import logging
+
 import casadi as ca
 import numpy as np
 import scipy.linalg as sla
@@ -38,9 +40,11 @@ import scipy.sparse.linalg as spla
 from ..assembly.wheelrail import has_creep
 from ..codegen.library import BufferedFunction, symbolic_kernels
 from ..dae.formulation import Formulation
-from ..errors import SolverError
+from ..errors import CompilerError, SolverError
 from .alpha_bulk import Bulk, step_data
 from .alpha_proxies import Proxies, move_back
+
+log = logging.getLogger(__name__)
 
 #: Unknowns of the rest above which its capacitance is factorized sparse (a vehicle's bodies,
 #: joints and contacts: hundreds of unknowns, a few nonzeros per row) instead of dense.
@@ -68,7 +72,8 @@ class StepEquations:
     ``b = (alpha_m a_n - alpha_f v_dot_n) / (1 - alpha_f)``."""
 
     def __init__(self, form: Formulation, variant: str, expand: bool = False, bulk: Bulk | None = None,
-                 mass_scale: float | None = None, proxies: bool = True):
+                 mass_scale: float | None = None, proxies: bool = True,
+                 compiled: bool | None = None):
         n_f, n_s, n_c, n_sc = form.n_f, form.n_s, form.n_c, form.n_sc
         self.n_u, self.n_c, self.n_s, self.n_sc = n_f + n_s, n_c, n_s, n_sc
         n_u = self.n_u
@@ -102,7 +107,9 @@ class StepEquations:
             model.element_override.clear()
             for sl, window in zip(model.windowed(), saved):
                 sl.window = window
-        rest, jac = _expanded_rest(rest)
+        if compiled is None:
+            compiled = bool(model.wheelrail)
+        rest, jac = _compiled_rest(rest) if compiled else _expanded_rest(rest)
         self._rest = BufferedFunction(rest)
         # the outputs are sparse (most rows belong to the bulk): their nonzeros' places
         self._r_rows = np.array(rest.sparsity_out(0).row(), int)
@@ -361,6 +368,28 @@ def _expanded_rest(rest: ca.Function) -> tuple[ca.Function, ca.Function]:
         args = rest.mx_in()
     jac = ca.Function("alpha_rest_jacobian", args, [ca.jacobian(rest(*args)[0], args[0])])
     return rest, jac
+
+
+def _compiled_rest(rest: ca.Function) -> tuple[ca.Function, ca.Function]:
+    """The rest's function and its Jacobian compiled to C, cached under a key of the graph
+    (:func:`symcat.codegen.model_dae.compiled_library`: once per machine and model, -O0 at
+    once and optimized in the background). A vehicle's rest (hundreds of unknowns, the wheel/rail
+    contacts' geometry and creep) is most of the step's work: optimized, its Jacobian evaluates
+    about 20 times faster than expanded in CasADi's virtual machine, and a cached library also
+    spares differentiating it at the start of every run."""
+    from ..codegen.library import merged
+    from ..codegen.model_dae import compiled_library, write_functions_c
+
+    def write(folder):
+        sx, jac = _expanded_rest(rest)
+        return write_functions_c([merged(sx), merged(jac)], "alpha_rest", folder)
+
+    try:
+        path = compiled_library("alpha_rest", rest.serialize().encode() + b"|alpha_rest|cse", write)
+    except (RuntimeError, CompilerError) as exc:  # no SX form, or no compiler: evaluated in CasADi
+        log.warning("the generalized-alpha step could not be compiled (%s); evaluating it in CasADi", exc)
+        return _expanded_rest(rest)
+    return ca.external("alpha_rest", str(path)), ca.external("alpha_rest_jacobian", str(path))
 
 
 def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: bool = False):
