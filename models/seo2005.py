@@ -9,7 +9,8 @@ the pantograph and the pan-head/wire contact are those of ``models/seo2005_caten
 from the same library pieces (:func:`symcat.catenary.seed.add_seed_catenary` and the scene fragment
 :func:`symcat.pantograph.seo2005.add_seo2005_pantograph`, whose modules list every dimension
 chosen there), with two changes: the pantograph's base hinge
-and its damper and coupling rod attach to the car body's roof, above the vehicle's centre, at
+and its damper and coupling rod attach to the car body's roof (which also carries the uplift's
+reaction: the uplift acts between the pantograph's base and frame), above the vehicle's centre, at
 ``ROOF_HEIGHT_M`` = 3.8 m above the rail top (assumed), and the wire is therefore at 6.3 m (the
 pantograph geometry puts the base 2.5 m below the wire).
 

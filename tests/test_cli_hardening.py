@@ -95,7 +95,7 @@ CASES = list(_cases())
 
 def test_the_table_of_bad_values_covers_every_model_and_parameter():
     models = {m for m, _, _ in CASES}
-    assert models == set(available_models()) and len(models) == 13
+    assert models == set(available_models()) and len(models) == 14
     params = {(m, p) for m, p, _ in CASES}
     assert params == {(m, p.name) for m in models for p in load_model(m).parameters}
     assert len(CASES) > 500

@@ -16,10 +16,12 @@ INTEGRATORS = ("idas", "generalized_alpha")
 ALPHA_VARIANTS = {"ggl": "stabilized", "1": "index3"}
 
 
-def integrator_parameters(dt_s: float = 1e-3, rho_inf: float = 0.9) -> list[Parameter]:
-    """The parameters that choose and tune the integrator (``integrator``, ``dt``, ``rho_inf``)."""
+def integrator_parameters(dt_s: float = 1e-3, rho_inf: float = 0.9, default: str = "idas") -> list[Parameter]:
+    """The parameters that choose and tune the integrator (``integrator``, ``dt``, ``rho_inf``);
+    ``default``: the model's integrator (IDAS for the multibody scenes, generalized-alpha for
+    line passages, whose wires IDAS resolves with thousands of steps per simulated second)."""
     return [
-        Parameter("integrator", "idas", "", "idas: variable step and order (rtol); generalized_alpha: fixed step "
+        Parameter("integrator", default, "", "idas: variable step and order (rtol); generalized_alpha: fixed step "
                   "dt with numerical dissipation rho_inf (augmented form; index ggl: position and velocity "
                   "constraints, stabilized index 2; index 1: position constraints, index 3)", choices=INTEGRATORS),
         Parameter("dt", dt_s, "s", "time step of generalized_alpha", minimum=0.0, exclusive_minimum=True, maximum=1.0),

@@ -40,7 +40,7 @@ class ScenePantograph:
 
 def seo2005_fragment(contact: str = "penalty", contact_stiffness: float = 5.0e4, contact_damping: float = 0.0,
                      contact_smoothing: float = 1.0e-5, aero_force: float = 0.0, rod_stiffness: float = 5.0e5,
-                     prefix: str = "pantograph_") -> ScenePantograph:
+                     prefix: str = "pantograph_", base: str | None = None) -> ScenePantograph:
     """The seed paper's four-body pantograph (:func:`symcat.pantograph.add_seo2005_pantograph`)
     as a :class:`ScenePantograph`.
 
@@ -56,12 +56,16 @@ def seo2005_fragment(contact: str = "penalty", contact_stiffness: float = 5.0e4,
         Coupling rod (N/m).
     prefix : str
         Before every element name.
+    base : str, optional
+        A rigid body of the scene the pantograph stands on (a car body,
+        :mod:`.scene_vehicle`) instead of its own driven carrier; the uplift's reaction then
+        pushes ``base`` down at the base hinge (:func:`~symcat.pantograph.add_seo2005_pantograph`).
     """
     from ..pantograph.seo2005 import add_seo2005_pantograph
     from ..scene import PointLoad
 
     def add(scene, wire, x0, speed, uplift):
-        names = add_seo2005_pantograph(scene, wire, x0, None, contact, None, speed, uplift, rod_stiffness,
+        names = add_seo2005_pantograph(scene, wire, x0, None, contact, base, speed, uplift, rod_stiffness,
                                        contact_stiffness, contact_damping, contact_smoothing, prefix=prefix)
         if aero_force:
             scene.add(PointLoad(prefix + "aero", names["panhead"], force=(0.0, 0.0, float(aero_force))))

@@ -166,7 +166,9 @@ def add_seo2005_pantograph(scene: Scene, wire: str, x0: float, z_wire: float | N
         Role -> name in ``scene`` of everything added (bodies ``lower_arm``, ``upper_arm``,
         ``plunger``, ``panhead`` and ``carrier`` (no ``base``); joints ``base_hinge``,
         ``elbow``, ``apex``, ``guide`` and ``track`` + ``drive`` or ``carrier_fixed``; force
-        elements ``primary_k1``, ``damper_k2``, ``leveller_k3``, ``coupling_rod``, ``uplift``;
+        elements ``primary_k1``, ``damper_k2``, ``leveller_k3``, ``coupling_rod``, ``uplift`` and,
+        on a given ``base``, ``uplift_reaction`` (the uplift's reaction on the base, at the base
+        hinge: the uplift acts between base and frame);
         ``contact``, the sliding joint or penalty contact), plus ``base``, the body the
         pantograph stands on. :func:`static_contact_force` and :func:`contact_history` take
         ``names["contact"]``.
@@ -212,6 +214,7 @@ def add_seo2005_pantograph(scene: Scene, wire: str, x0: float, z_wire: float | N
 
     g = geometry(x0, z0)
     vel = (speed, 0.0, 0.0)
+    user_base = base is not None
     if base is None:
         base = n["carrier"]
         scene.add(RigidBody(base, 50.0, (5.0, 5.0, 5.0), tuple(g["B"]), velocity=vel))
@@ -239,6 +242,11 @@ def add_seo2005_pantograph(scene: Scene, wire: str, x0: float, z_wire: float | N
     scene.add(SpringDamper(n["coupling_rod"], base, n["upper_arm"], at_i=tuple(g["rod_base"]),
                            at_j=tuple(g["rod_arm"]), stiffness=rod_stiffness, damping=500.0))
     scene.add(PointLoad(n["uplift"], n["plunger"], force=(0.0, 0.0, uplift)))
+    if user_base:
+        # The uplift is the pantograph's own drive, between its base and its frame: the body
+        # it stands on (a car body) carries its reaction, or the vehicle would be lifted by it.
+        n["uplift_reaction"] = prefix + "uplift_reaction"
+        scene.add(PointLoad(n["uplift_reaction"], base, at=tuple(g["B"]), force=(0.0, 0.0, -uplift)))
     if contact == "bilateral":
         scene.add(SlidingJoint(n["contact"], wire, n["panhead"], s0=s0, at=tuple(g["head"])))
     else:
