@@ -62,7 +62,7 @@ PARAMETERS = [
               minimum=-0.008, maximum=0.008),
     Parameter("rtol", 1e-6, "-", "IDAS relative tolerance", minimum=1e-12, maximum=1e-2),
     Parameter("n_out", 200, "-", "output intervals per simulated second", minimum=10, maximum=100000),
-    *integrator_parameters(),
+    *integrator_parameters(tol_m=1e-8),
 ]
 
 

@@ -96,7 +96,7 @@ PARAMETERS = [
               choices=("augmented", "embedded")),
     Parameter("index", "ggl", "", "constraint stabilization: ggl (stabilized index 2) or 1 (Baumgarte)",
               choices=("ggl", "1")),
-    *integrator_parameters(default="generalized_alpha"),
+    *integrator_parameters(default="generalized_alpha", tol_m=1e-7),
     Parameter("rtol", 1e-6, "-", "IDAS relative tolerance (absolute: rtol / 100)", minimum=1e-12, maximum=1e-2),
     Parameter("n_out", 200, "-", "outputs per simulated second (the contact force's samples; 200 resolve the 20 Hz "
               "filter's band)", minimum=10, maximum=100000),

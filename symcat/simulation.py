@@ -51,7 +51,8 @@ def integrate_model(model, p: dict, t_end: float, formulation: str, index: str, 
     ----------
     model : MultibodyModel
     p : dict
-        Holds ``integrator``, ``dt`` (s) and ``rho_inf`` (:func:`integrator_parameters`).
+        Holds ``integrator``, ``dt`` (s), ``rho_inf`` and optionally ``tol`` (m; default
+        1e-10) (:func:`integrator_parameters`).
     t_end : float
         Simulated time (s).
     formulation, index : str
@@ -75,4 +76,5 @@ def integrate_model(model, p: dict, t_end: float, formulation: str, index: str, 
         raise ParameterError(f"formulation={formulation} with integrator=generalized_alpha: generalized-alpha "
                              "integrates the augmented form; use formulation=augmented, or integrator=idas")
     return generalized_alpha(model, t_end, p["dt"], p["rho_inf"], variant=ALPHA_VARIANTS[str(index)],
-                             n_out=settings.n_out, progress=settings.progress, handlers=default_handlers(model))
+                             tol=p.get("tol", 1e-10), n_out=settings.n_out, progress=settings.progress,
+                             handlers=default_handlers(model))

@@ -16,10 +16,13 @@ INTEGRATORS = ("idas", "generalized_alpha")
 ALPHA_VARIANTS = {"ggl": "stabilized", "1": "index3"}
 
 
-def integrator_parameters(dt_s: float = 1e-3, rho_inf: float = 0.9, default: str = "idas") -> list[Parameter]:
-    """The parameters that choose and tune the integrator (``integrator``, ``dt``, ``rho_inf``);
-    ``default``: the model's integrator (IDAS for the multibody scenes, generalized-alpha for
-    line passages, whose wires IDAS resolves with thousands of steps per simulated second)."""
+def integrator_parameters(dt_s: float = 1e-3, rho_inf: float = 0.9, default: str = "idas",
+                          tol_m: float = 1e-10) -> list[Parameter]:
+    """The parameters that choose and tune the integrator (``integrator``, ``dt``, ``rho_inf``,
+    ``tol``); ``default``: the model's integrator (IDAS for the multibody scenes,
+    generalized-alpha for line passages, whose wires IDAS resolves with thousands of steps per
+    simulated second); ``tol_m``: generalized-alpha's Newton tolerance (m), as tight as the
+    model's checks need (the default keeps the iteration's error far below the step's)."""
     return [
         Parameter("integrator", default, "", "idas: variable step and order (rtol); generalized_alpha: fixed step "
                   "dt with numerical dissipation rho_inf (augmented form; index ggl: position and velocity "
@@ -27,4 +30,6 @@ def integrator_parameters(dt_s: float = 1e-3, rho_inf: float = 0.9, default: str
         Parameter("dt", dt_s, "s", "time step of generalized_alpha", minimum=0.0, exclusive_minimum=True, maximum=1.0),
         Parameter("rho_inf", rho_inf, "-", "spectral radius at infinite frequency of generalized_alpha (1: no "
                   "numerical dissipation)", minimum=0.0, maximum=1.0),
+        Parameter("tol", tol_m, "m", "Newton tolerance of generalized_alpha on the coordinates (absolute; "
+                  "multipliers counted as the position change they cause)", minimum=1e-13, maximum=1e-3),
     ]
