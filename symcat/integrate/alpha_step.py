@@ -51,7 +51,7 @@ log = logging.getLogger(__name__)
 DENSE_CAPACITANCE = 200
 #: A kept coupling (:meth:`StepEquations.keeps_coupling`) is prepared afresh after a step that
 #: took more Newton iterations than this.
-KEPT_ITERATIONS = 2
+KEPT_ITERATIONS = 4
 #: A Newton iteration that contracts by less than this per iteration updates its matrix.
 SLOW_CONTRACTION = 0.3
 
