@@ -99,7 +99,7 @@ class MultibodyModel:
         self.n_q = n_a + 7 * len(scene.rigid_bodies)
         self.q0 = np.concatenate([self.ancf.dofs.q0, *[b.q0 for b in scene.rigid_bodies]]) if self.n_q else np.zeros(0)
         self.v0 = np.concatenate([np.zeros(n_a), *[b.v0 for b in scene.rigid_bodies]]) if self.n_q else np.zeros(0)
-        fixed = np.concatenate([self.ancf.dofs.fixed, np.zeros(7 * len(scene.rigid_bodies), bool)])
+        fixed = np.concatenate([self.ancf.dofs.fixed, *[b.held_mask for b in scene.rigid_bodies]]).astype(bool)
         self.free = np.flatnonzero(~fixed)
         self.window_size = int(window)
         # id(Sliding) -> (start, length) symbols of the element a one-element window stands in
@@ -116,7 +116,8 @@ class MultibodyModel:
         self.wheelrail_shared = IdentityMemo()
         self.row_names: list[str] = []
         for body in scene.rigid_bodies:
-            self._add("normalization_rigid", body.name, [Side("rigid", self._rigid_indices(body.name), body)], {})
+            if "rotation" not in body.held:  # held Euler parameters stay normalized
+                self._add("normalization_rigid", body.name, [Side("rigid", self._rigid_indices(body.name), body)], {})
         for joint in scene.joints:
             self._add_joint(joint)
         for force in scene.force_elements:

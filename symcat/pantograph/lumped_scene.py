@@ -8,11 +8,13 @@ pan-head):
 ====================================  ==================================================================
 :class:`~symcat.interaction.CoupledLine`   scene element
 ====================================  ==================================================================
-pan-head position ``x_start + v t``   rigid body ``{name}_carrier`` on a :class:`Prismatic` along x to
-                                      the ground and a :class:`Driving` along x at ``speed`` (the roof)
-stage displacement ``u_i``            rigid body ``{name}_stage_{i}`` (mass ``masses[i]``) on a vertical
-                                      :class:`Prismatic` relative to the carrier: one coordinate, its
-                                      height; same mass, no rotation (inertia immaterial)
+pan-head position ``x_start + v t``   rigid body ``{name}_carrier`` holding y, z and its rotation
+                                      (``RigidBody.held``), a :class:`Driving` along x at ``speed``
+                                      (the roof)
+stage displacement ``u_i``            rigid body ``{name}_stage_{i}`` (mass ``masses[i]``) holding y
+                                      and its rotation, a :class:`Driving` along x with the carrier:
+                                      one free coordinate, its height; same mass, no rotation
+                                      (inertia immaterial)
 stage spring/damper ``k_i``, ``c_i``  :class:`SpringDamper` ``{name}_spring_{i}`` from stage ``i - 1``
                                       (the carrier for i = 0) to stage ``i``: the points stay vertically
                                       above each other, so its length is linear in the heights and the
@@ -65,7 +67,6 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..scene import (
-    GROUND,
     AncfBody,
     Driving,
     PenaltyContact,
@@ -183,8 +184,10 @@ def add_lumped_pantograph(scene: Scene, pantograph: LumpedPantograph, wire: str,
     vel = (float(speed), 0.0, 0.0)
     g = -float(scene.gravity_vector()[2])
     carrier = f"{name}_carrier"
-    scene.add(RigidBody(carrier, float(sum(p.masses)), (1.0, 1.0, 1.0), (x0, y, z_carrier), velocity=vel))
-    scene.add(Prismatic(f"{name}_track", carrier, GROUND, at=(x0, y, z_carrier), axis=(1.0, 0.0, 0.0)))
+    # Bodies that only translate hold their other coordinates (RigidBody.held) instead of being
+    # guided by prismatic joints: the carrier keeps x (driven), a stage x (driven) and z.
+    scene.add(RigidBody(carrier, float(sum(p.masses)), (1.0, 1.0, 1.0), (x0, y, z_carrier), velocity=vel,
+                        held=("y", "z", "rotation")))
     scene.add(Driving(f"{name}_drive", carrier, direction=(1.0, 0.0, 0.0), velocity=float(speed)))
     stages, springs = [], []
     below, z_below = carrier, z_carrier
@@ -193,8 +196,8 @@ def add_lumped_pantograph(scene: Scene, pantograph: LumpedPantograph, wire: str,
         stage = f"{name}_stage_{i}"
         m = float(p.masses[i]) - (shoe_mass if i == n - 1 else 0.0)
         at = (x0, y, heights[i])
-        scene.add(RigidBody(stage, m, (0.1 * m,) * 3, at, velocity=vel))
-        scene.add(Prismatic(f"{name}_guide_{i}", stage, carrier, at=at, axis=(0.0, 0.0, 1.0)))
+        scene.add(RigidBody(stage, m, (0.1 * m,) * 3, at, velocity=vel, held=("y", "rotation")))
+        scene.add(Driving(f"{name}_drive_{i}", stage, direction=(1.0, 0.0, 0.0), velocity=float(speed)))
         # compression of spring i in the static state: the static forces on the stages below it
         # (stage i and up carry f_i.. and the contact force = all of them)
         preload = float(f_static[:i].sum())

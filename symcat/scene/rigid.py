@@ -39,6 +39,10 @@ def g_bar(theta: np.ndarray) -> np.ndarray:
     return np.array([[-e1, e0, e3, -e2], [-e2, -e3, e0, e1], [-e3, e2, -e1, e0]])
 
 
+#: The coordinates a :class:`RigidBody` may hold (``held``).
+HELD = ("x", "y", "z", "rotation")
+
+
 @dataclass
 class RigidBody:
     """A rigid body (reference coordinates: frame origin at the centre of mass, Euler parameters).
@@ -58,6 +62,13 @@ class RigidBody:
         Initial orientation (body axes in global components, as columns).
     velocity, angular_velocity : sequence of 3 floats
         Initial velocity (m/s) and angular velocity in global components (rad/s).
+    held : sequence of str
+        Coordinates held at their initial values, any of ``"x"``, ``"y"``, ``"z"`` (the
+        centre of mass) and ``"rotation"`` (the four Euler parameters): eliminated from the
+        equations of motion like the pinned nodal coordinates of an ANCF body, instead of
+        removed by joints to the ground and their multipliers. A body that only translates
+        along one or two axes (a lumped pantograph's stages) costs one or two unknowns instead
+        of seven coordinates and six constraint rows. Their initial velocities must be zero.
     """
 
     name: str
@@ -67,6 +78,7 @@ class RigidBody:
     rotation: np.ndarray | None = None
     velocity: tuple = (0.0, 0.0, 0.0)
     angular_velocity: tuple = (0.0, 0.0, 0.0)
+    held: tuple = ()
     J: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self):
@@ -80,6 +92,21 @@ class RigidBody:
         if rot.shape != (3, 3) or not np.allclose(rot.T @ rot, np.eye(3), atol=1e-9) or np.linalg.det(rot) < 0:
             raise ParameterError(f"{self.name}.rotation: must be a proper 3x3 rotation matrix")
         self.rotation = rot
+        self.held = tuple(self.held)
+        unknown = [h for h in self.held if h not in HELD]
+        if unknown:
+            raise ParameterError(f"{self.name}.held={self.held!r}: {', '.join(map(repr, unknown))} not a coordinate; "
+                                 f"allowed: {', '.join(HELD)}")
+        moving = [a for k, a in enumerate("xyz") if a in self.held and self.velocity[k] != 0]
+        if moving or ("rotation" in self.held and np.any(np.asarray(self.angular_velocity, float) != 0)):
+            raise ParameterError(f"{self.name}.held={self.held!r}: a held coordinate must start at rest (velocity "
+                                 f"{tuple(self.velocity)} m/s, angular velocity {tuple(self.angular_velocity)} rad/s)")
+
+    @property
+    def held_mask(self) -> np.ndarray:
+        """Which of the 7 coordinates ``[x, y, z, e0..e3]`` are held (:attr:`held`)."""
+        mask = np.array([a in self.held for a in "xyz"] + ["rotation" in self.held] * 4)
+        return mask
 
     @property
     def params(self) -> np.ndarray:
