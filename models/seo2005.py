@@ -40,7 +40,8 @@ from symcat.pantograph.seo2005 import (B_DEPTH, G, MASSES, add_seo2005_pantograp
 from symcat.scene import Scene
 from symcat.simulation import integrate_model, integrator_parameters
 from symcat.vehicle import VehicleParameters, add_vehicle, wheel_forces
-from symcat.wheelrail import PAIR_NAMES, profile_pair
+from symcat.vehicle.model_parameters import CREEP_LAWS, running_parameters
+from symcat.wheelrail import profile_pair
 
 
 ROOF_HEIGHT_M = 3.8
@@ -54,12 +55,7 @@ PARAMETERS = [
     Parameter("speed", 17.0, "m/s", "vehicle speed", minimum=0.0, maximum=100.0, exclusive_minimum=True),
     *(_CATENARY[n] for n in ("wire_length", "tension", "wire_damping", "start", "uplift", "rod_stiffness",
                              "contact_stiffness", "contact_damping", "contact_smoothing")),
-    Parameter("profile", "s1002_uic60", "", "wheel/rail profiles", choices=PAIR_NAMES),
-    Parameter("creep", "linear", "", "wheel/rail creep forces", choices=("none", "linear", "nonlinear")),
-    Parameter("friction_coefficient", 0.3, "-", "wheel/rail friction coefficient (nonlinear creep)", minimum=0.0,
-              maximum=1.0, exclusive_minimum=True),
-    Parameter("lateral_offset_m", 0.0, "m", "initial lateral displacement of the vehicle toward the left rail",
-              minimum=-0.008, maximum=0.008),
+    *running_parameters(),
     Parameter("rtol", 1e-6, "-", "IDAS relative tolerance", minimum=1e-12, maximum=1e-2),
     Parameter("n_out", 200, "-", "output intervals per simulated second", minimum=10, maximum=100000),
     *integrator_parameters(tol_m=1e-8),
@@ -73,7 +69,7 @@ def build(p: dict):
     eq = solve_equilibrium(sub)
     scene = Scene(gravity=(0.0, 0.0, -G))
     layout = add_vehicle(scene, profile_pair(p["profile"], 0.05), speed_ms=p["speed"],
-                         creep={"nonlinear": "polach"}.get(p["creep"], p["creep"]),
+                         creep=CREEP_LAWS[p["creep"]],
                          friction_coefficient=p["friction_coefficient"], lateral_offset_m=p["lateral_offset_m"],
                          x_m=p["start"], parameters=VehicleParameters(), car_body_load_N=_roof_load_N(sub, eq))
     add_seed_catenary_from(scene, p, WIRE_HEIGHT_M)

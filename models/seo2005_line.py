@@ -72,7 +72,8 @@ from symcat.pantograph import en50367_mean_force
 from symcat.pantograph.seo2005 import B_DEPTH, wire_atol
 from symcat.simulation import integrate_model
 from symcat.vehicle import momentum_rate_N, wheel_forces
-from symcat.wheelrail import PAIR_NAMES, profile_pair
+from symcat.vehicle.model_parameters import CREEP_LAWS, running_parameters
+from symcat.wheelrail import profile_pair
 
 ROOF_HEIGHT_M = 3.8                          # the seed scene's roof above the rail top (models/seo2005.py)
 WIRE_HEIGHT_M = ROOF_HEIGHT_M + B_DEPTH      # contact wire at the supports
@@ -106,12 +107,7 @@ PARAMETERS = [
               exclusive_minimum=True),
     Parameter("rod_stiffness", 5e5, "N/m", "stiffness of the pantograph's coupling rod", minimum=0.0,
               exclusive_minimum=True),
-    Parameter("profile", "s1002_uic60", "", "wheel/rail profiles", choices=PAIR_NAMES),
-    Parameter("creep", "linear", "", "wheel/rail creep forces", choices=("none", "linear", "nonlinear")),
-    Parameter("friction_coefficient", 0.3, "-", "wheel/rail friction coefficient (nonlinear creep)", minimum=0.0,
-              maximum=1.0, exclusive_minimum=True),
-    Parameter("lateral_offset_m", 0.0, "m", "initial lateral displacement of the vehicle toward the left rail",
-              minimum=-0.008, maximum=0.008),
+    *running_parameters(),
     Parameter("progress", True, "", "show progress"),
 ]
 
@@ -159,7 +155,7 @@ def run(p: dict):
     line = build_vehicle_line(design, lambda base: pantograph_on(base=base), speed, target,
                               profile_pair(p["profile"], 0.05), elements_per_span=p["elements_per_span"],
                               analysis_spans=analysis_spans(p), t_end=duration,
-                              creep={"nonlinear": "polach"}.get(p["creep"], p["creep"]),
+                              creep=CREEP_LAWS[p["creep"]],
                               friction_coefficient=p["friction_coefficient"], lateral_offset_m=p["lateral_offset_m"],
                               progress=p["progress"])
     build_wall = time.perf_counter() - t0

@@ -22,7 +22,7 @@ from ..dae.formulation import Formulation
 from ..dae.initial import consistent_state
 from ..errors import SolverError
 from ..progress import Progress
-from ..run_control import check_interrupt, ended_early, integrating
+from ..run_control import check_interrupt, integrating
 from .alpha_run import AlphaRun
 from .event_stepping import CallFailed, EventStepper
 
@@ -157,10 +157,7 @@ def integrate_alpha_events(integ, form: Formulation, handler, t_end: float, dt: 
                 check_interrupt(t_s[a], t_end)
     except SolverError as err:
         bar.close()
-        stats["wall_s"] = time.perf_counter() - wall0
-        run.multipliers = run.multipliers[: len(run.xs)]
-        err.partial = run
-        if ended_early(err, t_s[len(run.xs) - 1], t_end):
+        if run.stopped(err, wall0, t_end):
             return run
         raise
     bar.close()

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..dae.formulation import Formulation
+from ..run_control import ended_early
 from .results import SimulationResult, collect_result
 
 
@@ -31,6 +32,15 @@ class AlphaRun:
     monitored: dict = field(default_factory=dict)
     modes: list | None = None  # an event handler's open flags at each output
     events: list = field(default_factory=list)
+
+    def stopped(self, err, wall0: float, t_end: float) -> bool:
+        """Close the run at its last output after the :class:`~symcat.errors.SolverError`
+        ``err``, which then carries it as ``partial``; True if the user ended the run early
+        (the caller returns the run), False if ``err`` is a failure (the caller raises it)."""
+        self.stats["wall_s"] = time.perf_counter() - wall0
+        self.multipliers = self.multipliers[: len(self.xs)]
+        err.partial = self
+        return ended_early(err, self.t_s[len(self.xs) - 1], t_end)
 
     def result(self, wall0: float | None = None, multipliers: str = "kkt") -> SimulationResult:
         """The :class:`SimulationResult` of these outputs (as :func:`simulate` returns it);

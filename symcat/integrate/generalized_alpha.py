@@ -87,7 +87,7 @@ from ..dae.formulation import Formulation
 from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
-from ..run_control import check_interrupt, ended_early, integrating
+from ..run_control import check_interrupt, integrating
 from .alpha_coefficients import AlphaCoefficients
 from .alpha_run import AlphaRun, StepState
 from .alpha_step import StepEquations, solve_step
@@ -400,10 +400,7 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
     except SolverError as err:
         bar.close()
         stats["factorizations"] = integ.stepper.bulk.factorizations
-        stats["wall_s"] = time.perf_counter() - wall0
-        run.multipliers = run.multipliers[: len(run.xs)]
-        err.partial = run
-        if ended_early(err, t_s[len(run.xs) - 1], t_end):
+        if run.stopped(err, wall0, t_end):
             return run
         raise
     bar.close()
