@@ -39,7 +39,7 @@ from symcat.pantograph.seo2005 import (B_DEPTH, G, MASSES, add_seo2005_pantograp
                                        static_contact_force, wire_atol)
 from symcat.scene import Scene
 from symcat.simulation import integrate_model, integrator_parameters
-from symcat.vehicle import VehicleParameters, add_vehicle, wheel_forces
+from symcat.vehicle import VehicleParameters, add_vehicle, wheel_forces, wheel_summary
 from symcat.vehicle.model_parameters import CREEP_LAWS, running_parameters
 from symcat.wheelrail import profile_pair
 
@@ -139,12 +139,7 @@ def run(p: dict) -> ModelOutput:
         "static_panhead_z_m": float(z[0]),
         "static_contact_force_N": static_force, "static_residual_N": eq.residual_N,
         "static_iterations": eq.iterations,
-        "wheel_names": names,
-        "wheel_normal_force_static_N": [float(wheels[n]["normal_N"][0]) for n in names],
-        "wheel_normal_force_min_N": [float(wheels[n]["normal_N"].min()) for n in names],
-        "wheel_normal_force_max_N": [float(wheels[n]["normal_N"].max()) for n in names],
-        "wheelset_lateral_displacement_max_m": [float(np.abs(res.coordinate(f"{w}.y")).max())
-                                                for w in layout.wheelsets],
+        **wheel_summary(res, layout, wheels),
     }
 
     def write(out):

@@ -71,7 +71,7 @@ from symcat.model import Model, Parameter
 from symcat.pantograph import en50367_mean_force
 from symcat.pantograph.seo2005 import B_DEPTH, wire_atol
 from symcat.simulation import integrate_model
-from symcat.vehicle import momentum_rate_N, wheel_forces
+from symcat.vehicle import momentum_rate_N, wheel_forces, wheel_summary
 from symcat.vehicle.model_parameters import CREEP_LAWS, running_parameters
 from symcat.wheelrail import profile_pair
 
@@ -188,12 +188,7 @@ def run(p: dict):
         "static_vertical_momentum_rate_N": float(momentum_rate_N(res, layout)[0, 2]),
         "contact_force_run_mean_N": float(np.mean(result.record.contact_force_N[:, 0])),
         "contact_force_run_std_N": float(np.std(result.record.contact_force_N[:, 0])),
-        "wheel_names": names,
-        "wheel_normal_force_static_N": [float(wheels[n]["normal_N"][0]) for n in names],
-        "wheel_normal_force_min_N": [float(wheels[n]["normal_N"].min()) for n in names],
-        "wheel_normal_force_max_N": [float(wheels[n]["normal_N"].max()) for n in names],
-        "wheelset_lateral_displacement_max_m": [float(np.abs(res.coordinate(f"{w}.y")).max())
-                                                for w in layout.wheelsets],
+        **wheel_summary(res, layout, wheels),
         "build_wall_s": build_wall, "integration_wall_s": run_wall, "integrator": p["integrator"],
     }
     out = passage_output(result, p, "seo2005_line", extra)

@@ -321,3 +321,17 @@ def library_interface(name: str) -> dict:
     if info is None:
         info = _INTERFACES[name] = read_manifest(generated_folder(name))["libraries"][name]["interface"]
     return info
+
+
+def write_functions_c(functions, name: str, folder: Path) -> Path:
+    """Generate the C of the SX ``functions`` into ``folder/<name>.c`` (its path)."""
+    cwd = os.getcwd()
+    os.chdir(folder)  # CasADi writes relative to the working directory
+    try:
+        gen = ca.CodeGenerator(f"{name}.c", {"with_header": False, "verbose": False})
+        for fn in functions:
+            gen.add(fn)
+        gen.generate()
+    finally:
+        os.chdir(cwd)
+    return folder / f"{name}.c"

@@ -11,7 +11,6 @@ cached under a key of the expanded function, so a model is compiled once per mac
 from __future__ import annotations
 
 import logging
-import os
 import tempfile
 import time
 from pathlib import Path
@@ -19,7 +18,7 @@ from typing import Callable
 
 import casadi as ca
 
-from .library import build_library, cached_library, find_compiler, merged, symbolic_kernels
+from .library import build_library, cached_library, find_compiler, merged, symbolic_kernels, write_functions_c
 from .optimized import OPTIMIZED_FLAGS, optimize_mode, source_path, start_background
 from ..progress import notice
 from .paths import atomic_write
@@ -95,20 +94,6 @@ def compiled_library(name: str, key: bytes, write_c: Callable[[Path], Path], mod
     if mode == "background" and source_path(optimized).exists():  # also a job that died
         start_background(optimized)
     return target
-
-
-def write_functions_c(functions, name: str, folder: Path) -> Path:
-    """Generate the C of the SX ``functions`` into ``folder/<name>.c`` (its path)."""
-    cwd = os.getcwd()
-    os.chdir(folder)  # CasADi writes relative to the working directory
-    try:
-        gen = ca.CodeGenerator(f"{name}.c", {"with_header": False, "verbose": False})
-        for fn in functions:
-            gen.add(fn)
-        gen.generate()
-    finally:
-        os.chdir(cwd)
-    return folder / f"{name}.c"
 
 
 def write_dae_c(build: Callable[[], ca.Function], name: str, folder: Path) -> Path:

@@ -377,8 +377,8 @@ def _compiled_rest(rest: ca.Function) -> tuple[ca.Function, ca.Function]:
     contacts' geometry and creep) is most of the step's work: optimized, its Jacobian evaluates
     about 20 times faster than expanded in CasADi's virtual machine, and a cached library also
     spares differentiating it at the start of every run."""
-    from ..codegen.library import merged
-    from ..codegen.model_dae import compiled_library, write_functions_c
+    from ..codegen.library import merged, write_functions_c
+    from ..codegen.model_dae import compiled_library
 
     def write(folder):
         sx, jac = _expanded_rest(rest)

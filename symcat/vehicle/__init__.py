@@ -5,8 +5,8 @@ from .builder import BOGIES, DRIVES, SIDES, WHEELSETS, VehicleLayout, add_vehicl
 from .curving import curve_track, steady_curving_forces_N
 from .parameters import VehicleParameters
 from .placement import WheelsetPlacement, wheelset_on_track
-from .wheel_forces import lateral_displacement_m, lateral_force_sum_N, momentum_rate_N, wheel_forces
+from .wheel_forces import lateral_displacement_m, lateral_force_sum_N, momentum_rate_N, wheel_forces, wheel_summary
 
 __all__ = ["BOGIES", "DRIVES", "SIDES", "WHEELSETS", "VehicleLayout", "VehicleParameters", "WheelsetPlacement",
            "add_vehicle", "check_start_on_tangent", "curve_track", "lateral_displacement_m", "lateral_force_sum_N",
-           "momentum_rate_N", "steady_curving_forces_N", "wheel_forces", "wheelset_on_track"]
+           "momentum_rate_N", "steady_curving_forces_N", "wheel_forces", "wheel_summary", "wheelset_on_track"]

@@ -142,3 +142,20 @@ def track_offset(track, position_m, s_guess_m):
         s = np.clip(s + np.einsum("ni,ni->n", p - f.R, f.A[:, :, 0]), 0.0, track.length_m)
     f = track.track_frame(s)
     return np.einsum("ni,ni->n", p - f.R, f.A[:, :, 1]), s
+
+
+def wheel_summary(result, layout, wheels: dict | None = None) -> dict:
+    """The wheel/rail summary keys of the models that run the vehicle (``seo2005``,
+    ``seo2005_line``): ``wheel_names``, each wheel's normal force at the start, its minimum and
+    maximum (N), and each wheelset's largest lateral displacement (m). ``wheels``: the
+    :func:`wheel_forces` of the run, if at hand."""
+    wheels = wheel_forces(result, layout) if wheels is None else wheels
+    names = layout.contact_names
+    return {
+        "wheel_names": names,
+        "wheel_normal_force_static_N": [float(wheels[n]["normal_N"][0]) for n in names],
+        "wheel_normal_force_min_N": [float(wheels[n]["normal_N"].min()) for n in names],
+        "wheel_normal_force_max_N": [float(wheels[n]["normal_N"].max()) for n in names],
+        "wheelset_lateral_displacement_max_m": [float(np.abs(result.coordinate(f"{w}.y")).max())
+                                                for w in layout.wheelsets],
+    }
