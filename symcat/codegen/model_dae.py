@@ -68,17 +68,21 @@ def model_library(build: Callable[[], ca.Function], fn: ca.Function, mode: str |
                             lambda folder: write_dae_c(build, name, folder), mode)
 
 
-def compiled_library(name: str, key: bytes, write_c: Callable[[Path], Path], mode: str | None = None) -> Path:
+def compiled_library(name: str, key: bytes, write_c: Callable[[Path], Path], mode: str | None = None,
+                     build: bool = True) -> Path | None:
     """Path of the cached library ``name`` identified by ``key``, compiled from the C that
     ``write_c(folder)`` writes (returning its path) when the library is not cached yet: -O0
     first and optimized in the background, or optimized now, or -O0 only (``mode``, default
-    ``$SYMCAT_OPTIMIZE``, :mod:`.optimized`)."""
+    ``$SYMCAT_OPTIMIZE``, :mod:`.optimized`). ``build=False``: only a library already cached
+    (``None`` if there is none)."""
     mode = optimize_mode() if mode is None else mode
     plain = cached_library(name, key, FLAGS)
     optimized = cached_library(name, key, OPTIMIZED_FLAGS)
     if mode != "off" and optimized.exists():
         return optimized
     target, flags = (optimized, OPTIMIZED_FLAGS) if mode == "now" else (plain, FLAGS)
+    if not build:
+        return target if target.exists() else plain if plain.exists() else None
     if not target.exists():
         t0 = time.perf_counter()
         with tempfile.TemporaryDirectory() as tmp:

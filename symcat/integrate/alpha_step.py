@@ -69,11 +69,14 @@ class StepEquations:
     the step with their tangency rows ``T(q, s_c) = 0`` (no multiplier; their normal forces are
     in ``Q``). ``p = [u_pred, v_pred, b, t_{n+1}, beta h^2, gamma h, (1 - alpha_m)/(1 - alpha_f)]``
     with ``u_pred = u_n + h v_n + h^2 (1/2 - beta) a_n``, ``v_pred = v_n + h (1 - gamma) a_n`` and
-    ``b = (alpha_m a_n - alpha_f v_dot_n) / (1 - alpha_f)``."""
+    ``b = (alpha_m a_n - alpha_f v_dot_n) / (1 - alpha_f)``.
+
+    ``compiled`` (models with wheel/rail contacts): True compiles the rest to C if it is not
+    cached yet (:func:`_compiled_rest`), None uses a cached library only, False never does."""
 
     def __init__(self, form: Formulation, variant: str, expand: bool = False, bulk: Bulk | None = None,
                  mass_scale: float | None = None, proxies: bool = True,
-                 compiled: bool | None = None):
+                 compiled: bool | None = True):
         n_f, n_s, n_c, n_sc = form.n_f, form.n_s, form.n_c, form.n_sc
         self.n_u, self.n_c, self.n_s, self.n_sc = n_f + n_s, n_c, n_s, n_sc
         n_u = self.n_u
@@ -107,9 +110,8 @@ class StepEquations:
             model.element_override.clear()
             for sl, window in zip(model.windowed(), saved):
                 sl.window = window
-        if compiled is None:
-            compiled = bool(model.wheelrail)
-        rest, jac = _compiled_rest(rest) if compiled else _expanded_rest(rest)
+        rest, jac = _compiled_rest(rest, build=compiled) if model.wheelrail and compiled is not False else \
+            _expanded_rest(rest)
         self._rest = BufferedFunction(rest)
         # the outputs are sparse (most rows belong to the bulk): their nonzeros' places
         self._r_rows = np.array(rest.sparsity_out(0).row(), int)
@@ -370,13 +372,15 @@ def _expanded_rest(rest: ca.Function) -> tuple[ca.Function, ca.Function]:
     return rest, jac
 
 
-def _compiled_rest(rest: ca.Function) -> tuple[ca.Function, ca.Function]:
+def _compiled_rest(rest: ca.Function, build: bool | None = True) -> tuple[ca.Function, ca.Function]:
     """The rest's function and its Jacobian compiled to C, cached under a key of the graph
     (:func:`symcat.codegen.model_dae.compiled_library`: once per machine and model, -O0 at
     once and optimized in the background). A vehicle's rest (hundreds of unknowns, the wheel/rail
     contacts' geometry and creep) is most of the step's work: optimized, its Jacobian evaluates
     about 20 times faster than expanded in CasADi's virtual machine, and a cached library also
-    spares differentiating it at the start of every run."""
+    spares differentiating it at the start of every run. ``build=None``: a library already
+    cached, else the expanded functions (a short run: compiling the seed scene's step takes
+    about 30 s, which its first thousand steps would not repay)."""
     from ..codegen.library import merged, write_functions_c
     from ..codegen.model_dae import compiled_library
 
@@ -385,9 +389,12 @@ def _compiled_rest(rest: ca.Function) -> tuple[ca.Function, ca.Function]:
         return write_functions_c([merged(sx), merged(jac)], "alpha_rest", folder)
 
     try:
-        path = compiled_library("alpha_rest", rest.serialize().encode() + b"|alpha_rest|cse", write)
+        path = compiled_library("alpha_rest", rest.serialize().encode() + b"|alpha_rest|cse", write,
+                                build=build is not None)
     except (RuntimeError, CompilerError) as exc:  # no SX form, or no compiler: evaluated in CasADi
         log.warning("the generalized-alpha step could not be compiled (%s); evaluating it in CasADi", exc)
+        return _expanded_rest(rest)
+    if path is None:
         return _expanded_rest(rest)
     return ca.external("alpha_rest", str(path)), ca.external("alpha_rest_jacobian", str(path))
 
