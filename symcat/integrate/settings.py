@@ -53,7 +53,9 @@ class IdasSettings:
         CasADi linear solver plugin for IDAS's Newton systems: ``csparse`` (sparse LU, 1.6x
         faster than CasADi's default ``qr`` on a 32-element wire), ``qr`` (sparse QR) or
         ``lapacklu`` (dense LU). Default: ``csparse`` at index 1, ``qr`` for GGL, whose
-        ill-conditioned index-2 matrices make the LU's pivoting fail (IDA_LSETUP_FAIL).
+        ill-conditioned index-2 matrices make the LU's pivoting fail (IDA_LSETUP_FAIL); a run
+        whose QR call fails goes on with ``csparse`` (QR has failed to start at tight
+        tolerances where LU integrates; ``stats["linear_solver_fallbacks"]``).
     compiled : bool, optional
         Compile the whole DAE residual and its Jacobian to C for this model
         (:mod:`symcat.codegen.model_dae`; about 10 s for the seed vehicle the first time, then

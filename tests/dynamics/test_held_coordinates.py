@@ -57,22 +57,25 @@ def test_held_coordinates_leave_three_unknowns_and_no_normalization_rows():
     assert len(held.row_names) == 2 and len(guided.row_names) > 10
 
 
-@pytest.mark.parametrize("integrator", ["idas", "generalized_alpha"])
+@pytest.mark.parametrize("integrator", ["idas_1", "idas_ggl", "generalized_alpha"])
 def test_a_held_body_moves_as_the_guided_one_and_as_the_closed_form(integrator):
     results = []
     for held in (True, False):
         model = _oscillator(held)
-        if integrator == "idas":
-            res = simulate(model, 0.5, "augmented", "1", rtol=1e-9, atol=1e-11, n_out=50, progress=False)
+        if integrator.startswith("idas"):
+            index = integrator.split("_")[1]
+            res = simulate(model, 0.5, "augmented", index, rtol=1e-9, atol=1e-11, n_out=50, progress=False)
+            # GGL's default QR fails to start here (h -> 1e-18); the run goes on with LU.
+            assert res.stats.get("linear_solver_fallbacks", 0) == (1 if index == "ggl" else 0)
         else:
             res = generalized_alpha(model, 0.5, 2.5e-4, 0.9, n_out=50, progress=False)
         results.append(res)
         z = res.coordinate("mass.z")
-        np.testing.assert_allclose(z, _closed_form(res.t_s), atol=1e-6 if integrator == "idas" else 2e-5)
+        np.testing.assert_allclose(z, _closed_form(res.t_s), atol=1e-6 if integrator != "generalized_alpha" else 2e-5)
         np.testing.assert_allclose(res.coordinate("mass.x"), SPEED * res.t_s, atol=1e-9)
         np.testing.assert_allclose(res.coordinate("mass.y"), 0.0, atol=1e-12)
     np.testing.assert_allclose(results[0].coordinate("mass.z"), results[1].coordinate("mass.z"),
-                               atol=1e-7 if integrator == "idas" else 1e-8)
+                               atol=1e-7 if integrator != "generalized_alpha" else 1e-8)
 
 
 def test_bad_held_coordinates_are_refused_with_their_names():
