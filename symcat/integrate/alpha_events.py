@@ -23,12 +23,11 @@ from ..dae.initial import consistent_state
 from ..errors import SolverError
 from ..progress import Progress
 from ..run_control import check_interrupt, integrating
+from .alpha_integrator import StepFailure
 from .alpha_run import AlphaRun
 from .event_stepping import CallFailed, EventStepper
+from .simulate import CONTACT_GROUP_S
 
-#: Output intervals grouped into one span of the driver (s), as under IDAS
-#: (:data:`.simulate.CONTACT_GROUP_S`): the calls cross output times.
-GROUP_S = 0.1
 
 
 class AlphaCalls:
@@ -36,7 +35,7 @@ class AlphaCalls:
 
     Parameters
     ----------
-    integ : generalized_alpha._Integrator
+    integ : alpha_integrator.Integrator
         The steps (its :class:`~.alpha_step.StepEquations` take the handler's open flags).
     dt : float
         Largest step (s).
@@ -78,8 +77,6 @@ class AlphaCalls:
         """The states at ``t_a + inner`` and at ``t_a + h`` (columns of ``(xs, zs)``), as
         :meth:`.event_stepping.EventStepper.call`; ``RuntimeError`` if a step fails at every
         allowed size (the driver then recovers and retries shorter)."""
-        from .generalized_alpha import _StepFailure
-
         integ = self.integ
         integ.open_rows = integ.form.open_rows(self.mode())
         state = self._state(x, z, t_a)
@@ -93,7 +90,7 @@ class AlphaCalls:
                 step = self.dt  # exactly: the wires' matrix is kept for this step size
             try:
                 state = integ.advance(state, t, step)
-            except _StepFailure as fail:
+            except StepFailure as fail:
                 raise RuntimeError(f"generalized-alpha: Newton did not converge in the step from t = "
                                    f"{fail.t0:.6g} s (the last try {fail.h:.3g} s long)") from None
             if t_next in outputs:
@@ -133,7 +130,7 @@ def integrate_alpha_events(integ, form: Formulation, handler, t_end: float, dt: 
     stepper = EventStepper(form, None, opts, x, z, stats, (), handler, calls=calls)
     lam_slice = form.blocks()[1]["lambda"].slice
     bar = Progress("generalized-alpha", t_end, "s", enabled=progress)
-    group = max(1, int(GROUP_S / (t_s[1] - t_s[0]) + 1e-9))
+    group = max(1, int(CONTACT_GROUP_S / (t_s[1] - t_s[0]) + 1e-9))  # as under IDAS
 
     def emit(j, x_j, z_j):
         run.xs.append(np.array(x_j, float))

@@ -29,8 +29,6 @@ or differentiating the whole graph, costs more than the rest of the step many ti
 """
 from __future__ import annotations
 
-import logging
-
 import casadi as ca
 import numpy as np
 import scipy.linalg as sla
@@ -40,11 +38,10 @@ import scipy.sparse.linalg as spla
 from ..assembly.wheelrail import has_creep
 from ..codegen.library import BufferedFunction, symbolic_kernels
 from ..dae.formulation import Formulation
-from ..errors import CompilerError, SolverError
+from ..errors import SolverError
 from .alpha_bulk import Bulk, step_data
 from .alpha_proxies import Proxies, move_back
-
-log = logging.getLogger(__name__)
+from .alpha_rest import compiled_rest, expanded_rest
 
 #: Unknowns of the rest above which its capacitance is factorized sparse (a vehicle's bodies,
 #: joints and contacts: hundreds of unknowns, a few nonzeros per row) instead of dense.
@@ -72,7 +69,7 @@ class StepEquations:
     ``b = (alpha_m a_n - alpha_f v_dot_n) / (1 - alpha_f)``.
 
     ``compiled`` (models with wheel/rail contacts): True compiles the rest to C if it is not
-    cached yet (:func:`_compiled_rest`), None uses a cached library only, False never does."""
+    cached yet (:func:`.alpha_rest.compiled_rest`), None uses a cached library only, False never does."""
 
     def __init__(self, form: Formulation, variant: str, expand: bool = False, bulk: Bulk | None = None,
                  mass_scale: float | None = None, proxies: bool = True,
@@ -110,8 +107,8 @@ class StepEquations:
             model.element_override.clear()
             for sl, window in zip(model.windowed(), saved):
                 sl.window = window
-        rest, jac = _compiled_rest(rest, build=compiled) if model.wheelrail and compiled is not False else \
-            _expanded_rest(rest)
+        rest, jac = compiled_rest(rest, build=compiled) if model.wheelrail and compiled is not False else \
+            expanded_rest(rest)
         self._rest = BufferedFunction(rest)
         # the outputs are sparse (most rows belong to the bulk): their nonzeros' places
         self._r_rows = np.array(rest.sparsity_out(0).row(), int)
@@ -358,45 +355,6 @@ class StepEquations:
         x[:n_b] -= z_bulk @ w[:n_t]
         x[n_b:] -= w[n_t:]
         return x
-
-
-def _expanded_rest(rest: ca.Function) -> tuple[ca.Function, ca.Function]:
-    """The rest's function (built on the kernels' SX forms) expanded to scalar operations, and
-    its Jacobian in the unknowns; the MX graph if a kernel has no SX form."""
-    try:
-        rest = rest.expand()
-        args = rest.sx_in()
-    except RuntimeError:
-        args = rest.mx_in()
-    jac = ca.Function("alpha_rest_jacobian", args, [ca.jacobian(rest(*args)[0], args[0])])
-    return rest, jac
-
-
-def _compiled_rest(rest: ca.Function, build: bool | None = True) -> tuple[ca.Function, ca.Function]:
-    """The rest's function and its Jacobian compiled to C, cached under a key of the graph
-    (:func:`symcat.codegen.model_dae.compiled_library`: once per machine and model, -O0 at
-    once and optimized in the background). A vehicle's rest (hundreds of unknowns, the wheel/rail
-    contacts' geometry and creep) is most of the step's work: optimized, its Jacobian evaluates
-    about 20 times faster than expanded in CasADi's virtual machine, and a cached library also
-    spares differentiating it at the start of every run. ``build=None``: a library already
-    cached, else the expanded functions (a short run: compiling the seed scene's step takes
-    about 30 s, which its first thousand steps would not repay)."""
-    from ..codegen.library import merged, write_functions_c
-    from ..codegen.model_dae import compiled_library
-
-    def write(folder):
-        sx, jac = _expanded_rest(rest)
-        return write_functions_c([merged(sx), merged(jac)], "alpha_rest", folder)
-
-    try:
-        path = compiled_library("alpha_rest", rest.serialize().encode() + b"|alpha_rest|cse", write,
-                                build=build is not None)
-    except (RuntimeError, CompilerError) as exc:  # no SX form, or no compiler: evaluated in CasADi
-        log.warning("the generalized-alpha step could not be compiled (%s); evaluating it in CasADi", exc)
-        return _expanded_rest(rest)
-    if path is None:
-        return _expanded_rest(rest)
-    return ca.external("alpha_rest", str(path)), ca.external("alpha_rest_jacobian", str(path))
 
 
 def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: bool = False):

@@ -104,7 +104,7 @@ class EventStepper:
     calls : object, optional
         Another integrator behind the calls: an object whose ``call(x, z, t_a, h, inner,
         free)`` does what :meth:`call` does (e.g. generalized-alpha,
-        :class:`.alpha_calls.AlphaCalls`); ``dae_fn`` and the IDAS options are then unused but
+        :class:`.alpha_events.AlphaCalls`); ``dae_fn`` and the IDAS options are then unused but
         for the tolerances in ``opts`` that the handler's :meth:`~.events.EventHandler.start`
         receives.
     """

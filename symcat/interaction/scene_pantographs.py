@@ -103,7 +103,7 @@ def lumped_fragment(pantograph, contact: str = "penalty", contact_stiffness: flo
                            description=f"{pantograph.name} as scene bodies")
 
 
-def _contact_element(scene, name: str):
+def contact_element(scene, name: str):
     from ..scene import PenaltyContact, SlidingJoint
 
     for e in scene.force_elements + scene.joints:
@@ -131,7 +131,7 @@ def _static(form, pantographs, wire: str, positions, speed: float, uplifts):
     from ..catenary.scene import catenary_scene
 
     scene = catenary_scene(form)
-    elements = [_contact_element(scene, panto.add(scene, wire, x0, speed, float(u)))
+    elements = [contact_element(scene, panto.add(scene, wire, x0, speed, float(u)))
                 for panto, x0, u in zip(pantographs, positions, uplifts)]
     model = MultibodyModel(scene)
     eq = solve_equilibrium(model)

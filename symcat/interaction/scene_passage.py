@@ -246,7 +246,7 @@ def _monitor(form, model, elements):
     return monitor
 
 
-def _record(res, form, model, element, snapshot_every: float) -> dict:
+def record_histories(res, form, model, element, snapshot_every: float) -> dict:
     """The SceneRecord arrays of a SimulationResult (per-step values from its ``monitored``
     records when there are, snapshots from its outputs)."""
     from ..scene import PenaltyContact
@@ -389,7 +389,7 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
     variant = "index3" if monitor is not None else "stabilized"
     res = generalized_alpha(model, duration, dt, rho_inf, variant=variant, n_out=n_out, tol=tol, progress=progress,
                             multipliers="integrator", monitor=monitor)  # no KKT solve per output
-    rec = SceneRecord(_record(res, form, model, elements[0], record_every), form, speed, dict(res.stats))
+    rec = SceneRecord(record_histories(res, form, model, elements[0], record_every), form, speed, dict(res.stats))
     rec.uplift_N, rec.static_contact_force_N = out.uplift_N, out.static_contact_force_N
     line._record = rec
     stats = [pantograph_statistics(rec.t_s, rec.x_contact_m[:, k], rec.contact_force_N[:, k], section,

@@ -38,8 +38,8 @@ from ..catenary.formfinding import FormFindingResult, find_form
 from ..errors import ParameterError
 from ..progress import notice
 from .passage import pantograph_statistics, passage_plan
-from .scene_pantographs import ScenePantograph, _contact_element, trim_uplifts
-from .scene_passage import SceneLine, ScenePassageResult, SceneRecord, _record
+from .scene_pantographs import ScenePantograph, contact_element, trim_uplifts
+from .scene_passage import SceneLine, ScenePassageResult, SceneRecord, record_histories
 
 #: The car body's name in :func:`symcat.vehicle.add_vehicle`'s scene: the pantograph's base.
 CAR_BODY = "car_body"
@@ -230,7 +230,7 @@ def build_vehicle_line(design: CatenaryDesign, pantograph_on: Callable[[str | No
                          car_body_load_N=roof_load)
     if layout.car_body != CAR_BODY:
         raise RuntimeError(f"add_vehicle named the car body {layout.car_body!r}, not {CAR_BODY!r}")
-    contact = _contact_element(scene, on_roof.add(scene, wire, x0, speed, uplifts[0]))
+    contact = contact_element(scene, on_roof.add(scene, wire, x0, speed, uplifts[0]))
     model = MultibodyModel(scene)
     n_cat = form.structure.n
     if model.coordinate_names()[:n_cat] != model1.coordinate_names()[:n_cat]:
@@ -280,7 +280,7 @@ def vehicle_passage_result(line: VehicleLine, res, speed: float, contact: str, r
                              wall_s=wall_s)
     if res is None:
         return out
-    rec = SceneRecord(_record(res, form, line.model, line.contact, record_every), form, speed, dict(res.stats))
+    rec = SceneRecord(record_histories(res, form, line.model, line.contact, record_every), form, speed, dict(res.stats))
     rec.uplift_N, rec.static_contact_force_N = out.uplift_N, out.static_contact_force_N
     scene_line._record = rec
     out.record = rec
