@@ -393,8 +393,7 @@ class MultibodyModel(ElementWindows):
         n_a = self.ancf.n
         if n_a:
             qa = q[:n_a]
-            for es in self.ancf.element_sets:
-                u += es.energy(qa)
+            u += self.ancf.strain_energy_expr(qa)
             u -= ca.dot(self.ancf.constant_load(), qa)
         g = self.scene.gravity_vector()
         for b in self.scene.rigid_bodies:

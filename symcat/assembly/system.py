@@ -43,20 +43,40 @@ class System:
 
     # --- MX builders ----------------------------------------------------------------------
     def internal_force(self, q: ca.MX, q_dot: ca.MX | None = None) -> ca.MX:
-        """Elastic (and, given ``q_dot``, damping) generalized forces."""
+        """Elastic (and, given ``q_dot``, damping) generalized forces; the elastic ones
+        linearized about the initial coordinates when the scene says ``linear_wires``."""
         f = ca.MX(self.n, 1)
+        if self.scene.linear_wires:
+            f_ref, k_ref, q_ref = self._linearization
+            f += f_ref - ca.mtimes(k_ref, q - q_ref)
         for es in self.element_sets:
-            f += es.force(q)
+            if not self.scene.linear_wires:
+                f += es.force(q)
             if q_dot is not None and es.damped:
                 f += es.damping(q, q_dot)
         return f
 
     def tangent_stiffness(self, q: ca.MX) -> ca.MX:
-        """``-d internal_force / d q`` without damping (sparse)."""
+        """``-d internal_force / d q`` without damping (sparse; constant with ``linear_wires``)."""
+        if self.scene.linear_wires:
+            return ca.MX(self._linearization[1])
         k = ca.MX(self.n, self.n)
         for es in self.element_sets:
             k += es.stiffness(q)
         return k
+
+    @cached_property
+    def _linearization(self) -> tuple[ca.DM, ca.DM, ca.DM]:
+        """Elastic forces and tangent stiffness at the initial coordinates, and those
+        coordinates (the reference of ``linear_wires``)."""
+        q = ca.MX.sym("q", self.n)
+        f, k = (ca.MX(self.n, 1), ca.MX(self.n, self.n))
+        for es in self.element_sets:
+            f += es.force(q)
+            k += es.stiffness(q)
+        q_ref = ca.DM(self.dofs.q0)
+        f_ref, k_ref = ca.Function("linearization", [q], [f, k])(q_ref)
+        return ca.DM(f_ref), ca.DM(k_ref), q_ref
 
     def external_force(self, q: ca.MX) -> ca.MX:
         """Gravity, dead nodal forces and slope moments."""
@@ -160,14 +180,28 @@ class System:
         j_colind, j_rows = fn.sparsity_out(1).get_ccs()
         return np.array(fn.sparsity_out(0).get_ccs()[1], dtype=int), np.array(j_colind), np.array(j_rows)
 
+    def strain_energy_expr(self, q: ca.MX) -> ca.MX:
+        """Strain energy (J) at ``q``; with ``linear_wires`` the energy whose gradient is the
+        linearized force, ``U(q0) - f(q0) dq + dq K(q0) dq / 2``."""
+        if self.scene.linear_wires:
+            f_ref, k_ref, q_ref = self._linearization
+            dq = q - q_ref
+            return self._reference_energy - ca.dot(f_ref, dq) + 0.5 * ca.dot(dq, ca.mtimes(k_ref, dq))
+        return sum((es.energy(q) for es in self.element_sets), ca.MX(0))
+
+    @cached_property
+    def _reference_energy(self) -> float:
+        q = ca.MX.sym("q", self.n)
+        u = sum((es.energy(q) for es in self.element_sets), ca.MX(0))
+        return float(ca.Function("energy", [q], [u])(self._linearization[2]))
+
     @cached_property
     def _energy_function(self) -> ca.Function:
         q = ca.MX.sym("q", self.n)
-        u = sum((es.energy(q) for es in self.element_sets), ca.MX(0))
-        return ca.Function("energy", [q], [u])
+        return ca.Function("energy", [q], [self.strain_energy_expr(q)])
 
     def strain_energy(self, q: np.ndarray) -> float:
-        """Strain energy (J)."""
+        """Strain energy (J), as :meth:`strain_energy_expr`."""
         return float(self._energy_function(ca.DM(q)))
 
     @cached_property

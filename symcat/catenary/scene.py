@@ -61,7 +61,7 @@ def _node_ref(structure, row: int, wire: str) -> tuple[str, int]:
 
 
 def catenary_scene(form: FormFindingResult, start: str = "static", rayleigh: str | None = None,
-                   anchor: float = SUPPORT_ANCHOR, scene: Scene | None = None) -> Scene:
+                   anchor: float = SUPPORT_ANCHOR, scene: Scene | None = None, wires: str = "nonlinear") -> Scene:
     """The form-found catenary as scene elements (see the module docstring).
 
     Parameters
@@ -80,6 +80,10 @@ def catenary_scene(form: FormFindingResult, start: str = "static", rayleigh: str
         Height (m) of the support springs' ground points above their nodes.
     scene : Scene, optional
         Add to this scene (its gravity must be the design's) instead of a new one.
+    wires : {"nonlinear", "linear"}
+        ``"linear"``: the wires' elastic forces linearized about their initial positions (the
+        static catenary with ``start="static"``; :attr:`Scene.linear_wires`, which then holds
+        for every ANCF body of the scene); droppers, supports and contacts stay nonlinear.
 
     Element names: bodies as in the structure (``contact``, ``messenger``; ``contact_2`` ...
     with several sections), ``dropper_{i}`` (i in the order of ``structure.dropper_nodes``),
@@ -103,11 +107,15 @@ def catenary_scene(form: FormFindingResult, start: str = "static", rayleigh: str
         raise ParameterError("form: the structure has no dropper lengths (not form-found)")
     if not (np.isfinite(anchor) and anchor > 0):
         raise ParameterError(f"anchor={anchor:g} m: must be > 0")
+    if wires not in ("nonlinear", "linear"):
+        raise ParameterError(f"wires={wires!r}: must be 'nonlinear' or 'linear'")
     gravity = (0.0, 0.0, -d.gravity)
     if scene is None:
         scene = Scene(gravity=gravity)
     elif not np.allclose(scene.gravity_vector(), gravity):
         raise ParameterError(f"scene.gravity={tuple(scene.gravity)}: the catenary needs {gravity}")
+    if wires == "linear":
+        scene.linear_wires = True
 
     # Wires, their supports (pins) and balance weights: the structure's own scene.
     q = np.asarray(form.q if start == "static" else st.q0, dtype=float)

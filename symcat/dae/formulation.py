@@ -139,12 +139,13 @@ class Formulation:
         return y if self._transform is None else self._transform[0] @ y
 
     # --- shared pieces ------------------------------------------------------------------------
-    def terms(self, q_f, v_f, s, w, t, sc=None, part: str = "all"):
+    def terms(self, q_f, v_f, s, w, t, sc=None, part: str = "all", contacts: bool = True):
         """Mass matrix, forces and constraint terms in free coordinates (MX); ``sc`` are the
         contact arc lengths (required when the model has penalty contacts). ``part="rest"``
         leaves the bulk's mass and forces out of ``M`` and ``Q`` (see
         :meth:`~symcat.assembly.multibody.MultibodyModel.forces`); constraints and contacts
-        belong to the rest."""
+        belong to the rest. ``contacts=False`` leaves the penalty contacts out (no ``T``,
+        ``gap``, ``fc``, nor their forces in ``Q``): for a caller that has their values."""
         m = self.model
         q = self.q_fixed + ca.mtimes(self.P, q_f)
         v = ca.mtimes(self.P, v_f)
@@ -152,7 +153,7 @@ class Formulation:
         mass = ca.mtimes(self.P.T, ca.mtimes(m.mass_matrix(q, part), self.P))
         f = m.forces(q, v, t, part)
         out = {"T": ca.MX(0, 1), "gap": ca.MX(0, 1), "fc": ca.MX(0, 1)}
-        if self.n_sc:
+        if self.n_sc and contacts:
             if sc is None:
                 raise ValueError("terms: the model has penalty contacts; pass their arc lengths sc")
             ct = contact_terms(m, q, v, sc)

@@ -75,7 +75,8 @@ class Integrator:
         u_pred = s.u + h * s.v + h * h * (0.5 - c.beta) * s.a
         v_pred = s.v + h * (1 - c.gamma) * s.a
         b = (c.alpha_m * s.a - c.alpha_f * s.v_dot) / (1 - c.alpha_f)
-        return np.r_[u_pred, v_pred, b, t0 + h, c.beta * h * h, c.gamma * h, (1 - c.alpha_m) / (1 - c.alpha_f)]
+        return np.concatenate([u_pred, v_pred, b, [t0 + h, c.beta * h * h, c.gamma * h,
+                                                    (1 - c.alpha_m) / (1 - c.alpha_f)]])
 
     def predictor(self, s: State, p: np.ndarray, h: float) -> np.ndarray:
         """``a``, ``lambda`` and ``s_c`` extrapolated linearly from the last two steps (one Newton

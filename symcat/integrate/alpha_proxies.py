@@ -2,6 +2,8 @@
 built once on a stand-in element of each wire, whatever element its contact is on."""
 from __future__ import annotations
 
+import bisect
+
 import casadi as ca
 import numpy as np
 
@@ -86,27 +88,70 @@ class Proxies:
             sl.window = (j, j + 1)
             self._model.element_override[id(sl)] = (w[2 * i], w[2 * i + 1])
 
-    def substitute(self, y, p):
-        """``(y, p)`` with each proxy's places holding its actual element's values, the
-        elements' start and length ``w``, and the maps ``(proxy, actual)`` of y indices."""
+    def restrict(self, y_columns: np.ndarray, p_columns: np.ndarray) -> None:
+        """The rest takes ``y[y_columns]`` and ``p[p_columns]`` only: where each proxy's places
+        are in them (-1: not an input)."""
         n_u = self.n_u
-        y2, p2 = y.copy(), p.copy()
+        y_at = np.full(int(max(y_columns.max(initial=0), 0)) + 1, -1)
+        y_at[y_columns] = np.arange(y_columns.size)
+        p_at = np.full(int(max(p_columns.max(initial=0), 0)) + 1, -1)
+        p_at[p_columns] = np.arange(p_columns.size)
+
+        def at(table, index):
+            inside = (index >= 0) & (index < table.size)
+            return np.where(inside, table[np.clip(index, 0, table.size - 1)], -1)
+
+        self._columns = (y_columns, p_columns)
+        self._elements: dict[int, dict] = {}
+        self._starts = [np.asarray(sl.element_start, float).tolist() for (sl, *_) in self.items]
+        self._places = [(at(y_at, index[j]), [at(p_at, index[j] + block * n_u) for block in range(3)])
+                        for (_, j, index, _, _) in self.items]
+
+    def substitute(self, y, p):
+        """The rest's inputs ``y[y_columns]`` and ``p[p_columns]`` (:meth:`restrict`) with each
+        proxy's places holding its actual element's values, the elements' start and length
+        ``w``, and the maps ``(proxy, actual)`` of y indices."""
+        y_columns, p_columns = self._columns
+        y_rest, p_rest = y[y_columns], p[p_columns]
         w = np.empty(2 * len(self.items))
         maps = []
-        for i, (sl, j, index, fixed, where) in enumerate(self.items):
-            n_el = len(sl.element_start) - 1
-            k = int(np.clip(np.searchsorted(sl.element_start, y[where], side="right") - 1, 0, n_el - 1))
+        for i, (*_, where) in enumerate(self.items):
+            starts = self._starts[i]
+            k = min(max(bisect.bisect_right(starts, float(y[where])) - 1, 0), len(starts) - 2)
+            proxy, actual, (y_to, y_from, y_fixed, y_values), (p_to, p_from, p_fixed, p_values) = self._element(i, k)
+            y_rest[y_to] = y[y_from]
+            y_rest[y_fixed] = y_values
+            p_rest[p_to] = p[p_from]
+            p_rest[p_fixed] = p_values
+            w[2 * i] = starts[k]
+            w[2 * i + 1] = starts[k + 1] - starts[k]
+            maps.append((proxy, actual))
+        return y_rest, p_rest, w, maps
+
+    def _element(self, i: int, k: int):
+        """Where the values of element ``k`` go in item ``i``'s proxy places of the rest's
+        inputs: ``(proxy, actual, y_parts, p_parts)``, each part ``(to, from, fixed_to,
+        fixed_values)`` (a fixed coordinate enters with its value and zero rates). Cached: a
+        contact stays on an element for many evaluations."""
+        cache = self._elements.setdefault(i, {})
+        found = cache.get(k)
+        if found is None:
+            n_u = self.n_u
+            _, j, index, fixed, _ = self.items[i]
+            y_at, p_at = self._places[i]
             proxy, actual = index[j], index[k]
             free = actual >= 0
-            at = np.where(free, actual, 0)
-            y2[proxy] = np.where(free, y[at], fixed[k])
-            p2[proxy] = np.where(free, p[at], fixed[k])
-            p2[n_u + proxy] = np.where(free, p[n_u + at], 0.0)
-            p2[2 * n_u + proxy] = np.where(free, p[2 * n_u + at], 0.0)
-            w[2 * i] = sl.element_start[k]
-            w[2 * i + 1] = sl.element_start[k + 1] - sl.element_start[k]
-            maps.append((proxy, actual))
-        return y2, p2, w, maps
+
+            def parts(places, offset, values):
+                on, off = (places >= 0) & free, (places >= 0) & ~free
+                return places[on], actual[on] + offset, places[off], values[off]
+
+            y_parts = parts(y_at, 0, fixed[k])
+            p_blocks = [parts(places, block * n_u, fixed[k] if block == 0 else np.zeros(fixed[k].shape))
+                        for block, places in enumerate(p_at)]
+            p_parts = tuple(np.concatenate([b[m] for b in p_blocks]) for m in range(4))
+            found = cache[k] = (proxy, actual, y_parts, p_parts)
+        return found
 
 
 def move_back(vector: np.ndarray, maps) -> None:

@@ -20,7 +20,8 @@ class AlphaRun:
     ``lambda_{n+1}`` (n_t, n_c) and statistics (``steps`` taken, halved ones included,
     ``newton_iterations``, ``factorizations``, ``rebuilds`` after element-window moves,
     ``halvings`` of failed steps, ``build_s`` the wall time spent building the step's functions,
-    ``dt``, ``rho_inf``, ``variant``)."""
+    ``dt``, ``rho_inf``, ``variant``) and, where the run records them, the penalty contacts'
+    gaps and normal forces at each output (``contacts``)."""
 
     form: Formulation
     t_s: np.ndarray
@@ -32,6 +33,7 @@ class AlphaRun:
     monitored: dict = field(default_factory=dict)
     modes: list | None = None  # an event handler's open flags at each output
     events: list = field(default_factory=list)
+    contacts: list = field(default_factory=list)  # (gaps, forces) of the penalty contacts at each output
 
     def stopped(self, err, wall0: float, t_end: float) -> bool:
         """Close the run at its last output after the :class:`~symcat.errors.SolverError`
@@ -51,6 +53,8 @@ class AlphaRun:
         if multipliers == "integrator":
             zb = self.form.blocks()[1]
             given = (np.asarray(self.zs, float).reshape(n, -1)[:, zb["a"].slice], self.multipliers[:n])
+            if self.form.n_sc and len(self.contacts) >= n:  # no contacts evaluated over whole wires
+                given += (tuple(np.array([c[k] for c in self.contacts[:n]], float) for k in range(2)),)
         modes = self.modes[:n] if self.modes is not None else [()] * n
         res = collect_result(self.form, self.t_s[:n], self.xs, self.zs, self.stats, wall0, modes, self.events,
                              self.walls, given)

@@ -94,15 +94,27 @@ class StepEquations:
                 self.proxies.install(w)
             # The rest depends on few unknowns: entered as a structurally sparse y, its graph and
             # Jacobian never touch the other thousands.
-            pattern = ca.Function("alpha_rest", [y, p, w, mode], [self._rows(y, p, mode)[0]]).sparsity_jac(0, 0)
-            self.rest_columns = np.unique(np.array(pattern.get_col(), int))
+            probe = ca.Function("alpha_rest", [y, p, w, mode], [self._rows(y, p, mode)[0]])
+            self.rest_columns = np.unique(np.array(probe.sparsity_jac(0, 0).get_col(), int))
             k = self.rest_columns.size
             y_rest = ca.MX.sym("y_rest", k)
             y_sparse = ca.MX(ca.Sparsity.triplet(n_y, 1, self.rest_columns.tolist(), [0] * k), y_rest)
+            # Likewise the step data: the predictors of the few unknowns it touches and the
+            # scalars (copying the whole p into the function at every call cost more than its
+            # evaluation on a line).
+            outputs = ca.vertcat(*self._rows(y, p, mode, contacts=True))
+            used = ca.Function("alpha_rest", [y, p, w, mode], [outputs]).sparsity_jac(1, 0).get_col()
+            self.p_columns = np.union1d(np.array(used, int), np.arange(3 * n_u, 3 * n_u + 4))
+            p_rest = ca.MX.sym("p_rest", self.p_columns.size)
+            p_sparse = ca.MX(ca.Sparsity.triplet(p.shape[0], 1, self.p_columns.tolist(), [0] * self.p_columns.size),
+                             p_rest)
             # Built on the kernels' SX forms and expanded: as scalar operations the rest's
             # Jacobian evaluates some 30 times faster than through the MX graph.
             with symbolic_kernels():
-                rest = ca.Function("alpha_rest", [y_rest, p, w, mode], list(self._rows(y_sparse, p, mode, contacts=True)))
+                rest = ca.Function("alpha_rest", [y_rest, p_rest, w, mode],
+                                   list(self._rows(y_sparse, p_sparse, mode, contacts=True)))
+            if self.proxies is not None:
+                self.proxies.restrict(self.rest_columns, self.p_columns)
         finally:
             model.element_override.clear()
             for sl, window in zip(model.windowed(), saved):
@@ -176,9 +188,9 @@ class StepEquations:
     def _inputs(self, y, p):
         """The rest's inputs at ``(y, p)`` and the proxies' maps (None without proxies)."""
         if self.proxies is None:
-            return y[self.rest_columns], p, np.zeros(0), self.mode, None
-        y2, p2, w, maps = self.proxies.substitute(y, p)
-        return y2[self.rest_columns], p2, w, self.mode, maps
+            return y[self.rest_columns], p[self.p_columns], np.zeros(0), self.mode, None
+        y_rest, p_rest, w, maps = self.proxies.substitute(y, p)
+        return y_rest, p_rest, w, self.mode, maps
 
     def _rest_values(self, y, p):
         """The rest's residual (n_y) and shift (n_u) at ``(y, p)``, dense."""
@@ -215,7 +227,8 @@ class StepEquations:
 
     def update(self, y, p) -> tuple:
         """``a``, ``v`` and ``v_dot`` at the end of the step whose unknowns are ``y``."""
-        shift = self._rest_values(y, p)[1]
+        # the index-3 form has no shift: no evaluation of the rest
+        shift = self._rest_values(y, p)[1] if self.variant == "stabilized" else 0.0
         u_pred, v_pred, b, _, bh2, gh, cm = step_data(p, self.n_u)
         a = (y[: self.n_u] - u_pred - shift) / bh2
         return a, v_pred + gh * a, cm * a + b
@@ -322,7 +335,7 @@ class StepEquations:
         if n_t:
             z_k[:n_t, :n_t] = z_bulk[touched]
         try:
-            cap = sla.lu_factor(np.eye(k) + delta @ z_k)
+            cap = sla.lu_factor(np.eye(k) + delta @ z_k, check_finite=False)
         except (ValueError, sla.LinAlgError):
             raise SolverError(_SINGULAR) from None
         if np.any(np.diag(cap[0]) == 0):
@@ -351,7 +364,7 @@ class StepEquations:
         n_b = self.bulk.n_b
         x = rhs.copy()
         x[:n_b] = self.bulk.solve(rhs[:n_b])
-        w = cap.solve(delta @ x[keys]) if isinstance(cap, spla.SuperLU) else sla.lu_solve(cap, delta @ x[keys])
+        w = cap.solve(delta @ x[keys]) if isinstance(cap, spla.SuperLU) else sla.lu_solve(cap, delta @ x[keys], check_finite=False)
         x[:n_b] -= z_bulk @ w[:n_t]
         x[n_b:] -= w[n_t:]
         return x

@@ -165,6 +165,12 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
     state = integ.start(x, z, h)
     run.multipliers[0] = state.lam
 
+    def contacts(t):
+        if form.n_sc:
+            run.contacts.append(integ.stepper.contacts(state.u, state.v, state.sc, t))
+
+    contacts(0.0)
+
     def record(t):
         if monitor is None:
             return
@@ -196,6 +202,7 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
                 run.xs.append(x)
                 run.zs.append(z)
                 run.multipliers[out] = state.lam
+                contacts(t_s[out])
                 run.walls.append(time.perf_counter() - wall0)
                 bar.update(t_s[out])
                 check_interrupt(t_s[out], t_end)

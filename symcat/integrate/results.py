@@ -105,10 +105,12 @@ def collect_result(form: Formulation, t, xs, zs, stats, wall0, opens, events, wa
                    given=None) -> SimulationResult:
     """The :class:`SimulationResult` of the outputs ``xs``, ``zs`` at times ``t``.
 
-    ``given = (accelerations, multipliers)`` (free internal coordinates, (n, n_f) and (n, n_c)):
-    the integrator's own, used instead of solving the KKT system at each output (which costs a
-    sparse factorization of the mass matrix per output: most of the post-processing of a long
-    run on a line)."""
+    ``given = (accelerations, multipliers[, contacts])`` (free internal coordinates, (n, n_f) and
+    (n, n_c)): the integrator's own, used instead of solving the KKT system at each output
+    (which costs a sparse factorization of the mass matrix per output: most of the
+    post-processing of a long run on a line); ``contacts``, if given and not None, the penalty
+    contacts' gaps and normal forces ((n, n_sc) each), used instead of evaluating the contacts
+    with windows over whole wires."""
     model = form.model
     # Post-processing sees the whole wire: the integration windows have moved on.
     saved = [sl.window for sl in model.windowed()]
@@ -133,7 +135,8 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events, given=No
     state = _stacked_state(form, xs, zs)
     n_t = state["q"].shape[0]
     q, v = _physical(form, state["q"], model.q0), _physical(form, state["v"], np.zeros(model.n_q))
-    post = _PostTerms(form, light=given is not None)
+    given_contacts = given[2] if given is not None and len(given) > 2 else None
+    post = _PostTerms(form, light=given is not None, contacts=given_contacts is None)
     n_w = len(model.wheelrail)
     gaps, contact_forces = np.zeros((n_t, form.n_sc)), np.zeros((n_t, form.n_sc))
     acc = np.zeros_like(q)
@@ -150,7 +153,11 @@ def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events, given=No
         rows = slice(lo, min(lo + CHUNK, n_t))
         chunk = {name: x[rows] for name, x in state.items()}
         terms = post.evaluate(chunk, t_in[rows])
-        gaps[rows], contact_forces[rows], s_dot[rows] = terms["gap"], terms["fc"], terms["s_dot"]
+        if given_contacts is None:
+            gaps[rows], contact_forces[rows] = terms["gap"], terms["fc"]
+        else:
+            gaps[rows], contact_forces[rows] = given_contacts[0][rows], given_contacts[1][rows]
+        s_dot[rows] = terms["s_dot"]
         kin[rows], pot[rows] = terms["kinetic"][:, 0], terms["potential"][:, 0]
         closed = _closed_mask(model.n_c, open_rows[rows])
         pos[rows], vel[rows] = _max_abs(terms["C"], closed), _max_abs(terms["C_dot"], closed)
@@ -263,12 +270,12 @@ class _PostTerms:
     creep records and joint reactions. The sparsity patterns are the same at every output, so
     the KKT matrices and reactions are assembled by index maps built once."""
 
-    def __init__(self, form: Formulation, light: bool = False):
+    def __init__(self, form: Formulation, light: bool = False, contacts: bool = True):
         from ..assembly.wheelrail import has_creep
 
         self.form = form
         model = form.model
-        fn, self.patterns = _terms_function(form, light)
+        fn, self.patterns = _terms_function(form, light, contacts)
         self._terms, self._names = _Mapped(fn), fn.name_out()
         self.creep = _Mapped(form.creep_function()) if has_creep(model) else None
         self._normal = _Mapped(form.normal_direction_function()) if model.wheelrail else None
@@ -326,12 +333,15 @@ class _PostTerms:
                 for m_nz, f in zip(terms["M"], terms["Q"])]
 
 
-def _terms_function(form: Formulation, light: bool = False) -> tuple[ca.Function, dict]:
+def _terms_function(form: Formulation, light: bool = False, contacts: bool = True) -> tuple[ca.Function, dict]:
     """One output's terms as a function of ``(q, v, s, w, t, sc)``: ``C``, its rate ``C_dot``,
     ``s_dot``, the nonzeros of ``Cq``, ``Cs`` and ``M``, ``Q``, ``Qd``, contact ``gap`` and ``fc``,
     ``kinetic`` and ``potential`` energy; and the patterns of the sparse matrices. ``light``:
     without ``M``, ``Q`` and ``Qd`` (the KKT system's, not solved when the integrator's
-    multipliers are given)."""
+    multipliers are given). ``contacts=False`` (light only): without the penalty contacts'
+    terms, whose values the integrator gave."""
+    if not (light or contacts):
+        raise ValueError("_terms_function: contacts=False needs light=True (the KKT forces include the contacts)")
     model = form.model
     n_f, n_s = form.n_f, form.n_s
     qs, vs = ca.MX.sym("q", n_f), ca.MX.sym("v", n_f)
@@ -341,7 +351,7 @@ def _terms_function(form: Formulation, light: bool = False) -> tuple[ca.Function
         s_dot = form.embedded_terms(qs, vs, ss, ts, scs)["s_dot"]
     else:
         s_dot = ws
-    kk = form.terms(qs, vs, ss, s_dot, ts, scs)
+    kk = form.terms(qs, vs, ss, s_dot, ts, scs, contacts=contacts)
     qf = form.q_fixed + ca.mtimes(form.P, qs)
     vf = ca.mtimes(form.P, vs)
     sparse = {"Cq": kk["Cq"], "Cs": kk["Cs"]} if light else {"Cq": kk["Cq"], "Cs": kk["Cs"], "M": kk["M"]}

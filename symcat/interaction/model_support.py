@@ -121,7 +121,7 @@ def check_scene_pantograph(p: dict, stagger: float, n_pantographs: int = 1, tens
     Parameters
     ----------
     p : dict
-        Model parameters (``pantograph``, ``wires``, ``contact``).
+        Model parameters (``pantograph``, ``contact``).
     stagger : float
         Contact-wire stagger (m) of the design: bilateral contact needs an unstaggered wire.
     n_pantographs, tension_sections : int
@@ -139,9 +139,6 @@ def check_scene_pantograph(p: dict, stagger: float, n_pantographs: int = 1, tens
     if tension_sections != 1:
         raise ParameterError(f"tension_sections={tension_sections} with {name}: the multibody passage runs on one "
                              "tension section (tension_sections=1); overlaps need pantograph=lumped")
-    if p["wires"] != "nonlinear":
-        raise ParameterError(f"wires={p['wires']} with {name}: the catenary scene carries nonlinear wires only "
-                             "(wires=nonlinear)")
     if p["contact"] == "bilateral" and stagger != 0:
         raise ParameterError(f"contact=bilateral with {name}: the contact wire is staggered (+/-{abs(stagger):g} m) "
                              "and the sliding joint would pull it onto the pantograph's plane; allowed: "
@@ -178,7 +175,7 @@ def run_scene_pantograph(design, p: dict, speed: float, target_force: float, ste
                                element=o["element"], analysis_spans=o["analysis_spans"], dt=o["dt"],
                                rho_inf=o["rho_inf"], tol=o["tol"], t_end=o["t_end"], record_every=o["record_every"],
                                progress=o["progress"], contact=p["contact"], form=form,
-                               spacing=p.get("spacing_m", 200.0))
+                               spacing=p.get("spacing_m", 200.0), wires=o["wires"])
     extra = {**extra, "pantograph": p["pantograph"], "uplift_N": result.uplift_N,
              "static_contact_force_N": result.static_contact_force_N,
              "target_static_contact_force_N": result.target_force_N, "uplift_static_solves": result.static_solves}

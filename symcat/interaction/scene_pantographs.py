@@ -123,14 +123,14 @@ def static_force(eq, element) -> float:
     return -float(eq.reactions_N[element.name][2])
 
 
-def _static(form, pantographs, wire: str, positions, speed: float, uplifts):
+def _static(form, pantographs, wire: str, positions, speed: float, uplifts, wires: str = "nonlinear"):
     """Scene, model, contact elements and equilibrium of the ``pantographs`` at ``positions``
-    (m) with ``uplifts`` (N)."""
+    (m) with ``uplifts`` (N) under the catenary with ``wires`` (:func:`catenary_scene`)."""
     from ..analysis.equilibrium import solve_equilibrium
     from ..assembly.multibody import MultibodyModel
     from ..catenary.scene import catenary_scene
 
-    scene = catenary_scene(form)
+    scene = catenary_scene(form, wires=wires)
     elements = [contact_element(scene, panto.add(scene, wire, x0, speed, float(u)))
                 for panto, x0, u in zip(pantographs, positions, uplifts)]
     model = MultibodyModel(scene)
@@ -139,12 +139,13 @@ def _static(form, pantographs, wire: str, positions, speed: float, uplifts):
 
 
 def trim_uplifts(form, pantographs, target_force: float, wire: str, positions, speed: float,
-                 force_rtol: float = 1e-9, max_solves: int = 8):
+                 force_rtol: float = 1e-9, max_solves: int = 8, wires: str = "nonlinear"):
     """The uplifts (N) whose static contact forces are ``target_force`` (N), the ``pantographs``
     standing at ``positions`` (m): two static solves (a pantograph's force is affine in its
     uplift), then secant steps while a force is off by more than ``force_rtol`` relative (the
     pantograph's geometry moves slightly with its height; several pantographs interact through
-    the wire, weakly, so each has its own secant).
+    the wire, weakly, so each has its own secant). ``wires``: the catenary's wire model
+    (:func:`~symcat.catenary.scene.catenary_scene`).
 
     Returns
     -------
@@ -162,12 +163,12 @@ def trim_uplifts(form, pantographs, target_force: float, wire: str, positions, s
         return np.abs(f - target_force).max() <= force_rtol * abs(target_force)
 
     u0 = np.array([float(p.uplift) for p in pantographs])
-    built = _static(form, pantographs, wire, positions, speed, u0)
+    built = _static(form, pantographs, wire, positions, speed, u0, wires)
     f0 = np.array([static_force(built[3], e) for e in built[2]])
     solves = 1
     u1 = u0 + (target_force - f0)  # unit sensitivity as the first guess (uplift at the pan-head)
     while solves < max_solves and not done(f0):
-        built1 = _static(form, pantographs, wire, positions, speed, u1)
+        built1 = _static(form, pantographs, wire, positions, speed, u1, wires)
         f1 = np.array([static_force(built1[3], e) for e in built1[2]])
         solves += 1
         if not np.all((f1 > 0) | (f0 > 0)):

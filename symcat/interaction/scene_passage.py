@@ -58,7 +58,7 @@ paper's four-body pantograph plugs in through the same mechanism (:func:`seo2005
 
 Several pantographs: pass a list of fragments with distinct element names (penalty contacts),
 ``spacing`` apart, leading first (:func:`lumped_fragment` takes a ``name``). Limits: one tension
-section (no overlaps), the nonlinear wires (no ``wires="linear"``). Not recorded on this path (a :class:`SceneRecord` lists them in
+section (no overlaps). Not recorded on this path (a :class:`SceneRecord` lists them in
 ``not_computed``): the energy balance of the passage and the Newton iterations per step.
 """
 from __future__ import annotations
@@ -300,7 +300,7 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
                       lead_in: float | None = None, dt: float = 1e-3, rho_inf: float = 0.8, tol: float = 1e-4,
                       t_end: float | None = None, record_every: float = 0.05, progress: bool = True,
                       form: FormFindingResult | None = None, wire: str = "contact", contact: str = "penalty",
-                      force_rtol: float = 1e-9, spacing: float = 200.0) -> ScenePassageResult:
+                      force_rtol: float = 1e-9, spacing: float = 200.0, wires: str = "nonlinear") -> ScenePassageResult:
     """Run a multibody ``pantograph`` over the form-found ``design`` at ``speed`` (m/s) with the
     static contact force ``target_force`` (N); EN 50318 statistics as :func:`~.passage.run_passage`.
 
@@ -337,6 +337,9 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
     spacing : float
         Distance (m) between pantographs when ``pantograph`` is a list (leading first, as
         :func:`~.passage.run_passage` places them; penalty contacts, distinct element names).
+    wires : {"nonlinear", "linear"}
+        The wires' elasticity: ANCF, or linearized about the static catenary without
+        pantographs (:func:`~symcat.catenary.scene.catenary_scene`; as ``run_passage``'s).
 
     Returns
     -------
@@ -362,7 +365,7 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
         notice(f"trimming the uplift of the {pantographs[0].name} pantograph{'s' if n_p > 1 else ''} to a static "
                f"contact force of {target_force:g} N (static solves of the joint equilibrium)")
     uplifts, forces, (_, model, elements, eq), solves = trim_uplifts(form, pantographs, target_force, wire, positions,
-                                                                     speed, force_rtol)
+                                                                     speed, force_rtol, wires=wires)
     from ..scene import PenaltyContact
 
     if n_p > 1 and not all(isinstance(e, PenaltyContact) for e in elements):

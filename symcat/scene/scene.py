@@ -28,9 +28,15 @@ class Scene:
     ----------
     gravity : sequence of 3 floats
         Gravity vector (m/s^2). Planar elements live in the xy-plane and use its x and y parts.
+    linear_wires : bool
+        Linearize the ANCF elements' elastic forces about the bodies' initial coordinates
+        (``f(q0) - K(q0) (q - q0)``; damping, force elements, joints and contacts stay
+        nonlinear): the usual model of a catenary, whose wires move by centimetres about their
+        static state; a run with and without tells the size of the geometric nonlinearity.
     """
 
     gravity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    linear_wires: bool = False
     bodies: list[AncfBody] = field(default_factory=list)
     loads: list[NodalForce | NodalMass | SlopeMoment] = field(default_factory=list)
     rigid_bodies: list[RigidBody] = field(default_factory=list)

@@ -135,3 +135,67 @@ def test_passage_agrees_with_interaction_path(form):
     again = generalized_alpha(model, 0.2, DT, RHO, n_out=200, progress=False)
     first = res.contacts[info["contact"]]["force_N"][:201]
     assert np.abs(again.contacts[info["contact"]]["force_N"] - first).max() < 1e-6
+
+
+def test_linear_wires_agree_with_interaction_path(form):
+    """``wires="linear"`` on both paths: the scene's ANCF forces linearized about the static
+    catenary (Scene.linear_wires) against CoupledLine's linearized structure. Measured: 0.055 N
+    rms and 0.20 N max apart (as the nonlinear paths are, for the reasons of the module
+    docstring), mean 0.004 N, std 0.015 N; the nonlinear scene is 0.24 N rms and 0.75 N max
+    from the linear interaction path, so bounds of twice the measured differences tell the
+    linearized wires from the nonlinear ones."""
+    panto = benchmark2015_pantograph(SPEED_KMH)
+    ip = run_passage(benchmark2015(SPANS), [panto], SPEED, elements_per_span=ELEMENTS, contact="penalty", dt=DT,
+                     rho_inf=RHO, t_end=T_END, record_every=DT, progress=False, form=form, wires="linear")
+    t_a, f_a = ip.record.t_s, ip.record.contact_force_N[:, 0]
+    form.structure.linearize_wires(None)  # run_passage leaves the structure linearized
+
+    results = {}
+    for wires in ("linear", "nonlinear"):
+        scene = catenary_scene(form, wires=wires)
+        assert scene.linear_wires == (wires == "linear")
+        z = loaded_wire_height(form, X0, float(panto.static_force(SPEED).sum()))
+        info = add_lumped_pantograph(scene, panto, "contact", X0, SPEED, contact="penalty", head_z=z)
+        model = MultibodyModel(scene)
+        eq = solve_equilibrium(model)
+        eq.apply(model)
+        res = generalized_alpha(model, T_END, DT, RHO, n_out=round(T_END / DT), progress=False,
+                                multipliers="integrator")
+        results[wires] = np.interp(t_a, res.t_s, res.contacts[info["contact"]]["force_N"])
+    keep = t_a >= STARTUP
+    a, b, c = f_a[keep], results["linear"][keep], results["nonlinear"][keep]
+    assert a.std() > 10.0
+    assert abs(b.mean() - a.mean()) < 0.01
+    assert abs(b.std() - a.std()) < 0.03
+    rms = lambda x: float(np.sqrt(np.mean(x ** 2)))
+    assert rms(b - a) < 0.12
+    assert np.abs(b - a).max() < 0.4
+    assert rms(c - a) > 2 * rms(b - a)  # the nonlinear wires are told apart at these bounds
+
+
+def test_linear_wires_forces_energy_and_stiffness(form):
+    """Scene.linear_wires: at the initial coordinates the forces are the nonlinear ones; away
+    from them they are f0 - K0 dq exactly, the stiffness is K0 everywhere, and the strain
+    energy's gradient is the force (central differences)."""
+    import casadi as ca
+
+    lin, nonlin = (MultibodyModel(catenary_scene(form, wires=w)).ancf for w in ("linear", "nonlinear"))
+    n = lin.n
+    q = ca.MX.sym("q", n)
+    f_lin = ca.Function("f", [q], [lin.internal_force(q), lin.tangent_stiffness(q)])
+    f_non = ca.Function("f", [q], [nonlin.internal_force(q), nonlin.tangent_stiffness(q)])
+    q0 = np.asarray(lin.dofs.q0, float)
+    f0_lin, k0_lin = (np.array(x) for x in f_lin(q0))
+    f0_non, k0_non = (np.array(x) for x in f_non(q0))
+    assert np.abs(f0_lin - f0_non).max() <= 1e-9 * np.abs(f0_non).max()
+    assert np.abs(k0_lin - k0_non).max() <= 1e-9 * np.abs(k0_non).max()
+    rng = np.random.default_rng(3)
+    dq = 1e-3 * rng.standard_normal(n)
+    f1, k1 = (np.array(x) for x in f_lin(q0 + dq))
+    assert np.allclose(f1.ravel(), (f0_non - k0_non @ dq[:, None]).ravel(), rtol=0, atol=1e-8 * np.abs(f0_non).max())
+    assert np.array_equal(k1, k0_lin)
+    f1_non = np.array(f_non(q0 + dq)[0]).ravel()
+    assert np.abs(f1_non - f1.ravel()).max() > 1e-6  # the nonlinear force does differ there
+    step = 1e-6 * rng.standard_normal(n)
+    u_plus, u_minus = lin.strain_energy(q0 + dq + step), lin.strain_energy(q0 + dq - step)
+    assert (u_plus - u_minus) == pytest.approx(-2 * f1.ravel() @ step, rel=1e-5)
