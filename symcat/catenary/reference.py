@@ -101,7 +101,8 @@ def en50318(n_spans: int = 10, presag_max: float = 0.055) -> CatenaryDesign:
     clamp masses (none given: taken as zero), Rayleigh damping fitted to 0.5 % at 1 and 20 Hz,
     and no stagger. ``presag_max`` (m) is the presag at mid-span: the public data give 55 mm
     as a maximum, and the statistics depend on it more than on any other open value (the
-    sensitivity study in ``models/en50318.py``).
+    sensitivity study in ``models/en50318.py``). The standard's own presag and dropper layout
+    (Annex A) are not in the public record (issue 30), so the presag stays an assumption.
     """
     positions = (5.0, 10.5, 17.0, 23.5, 30.0, 36.5, 43.0, 49.5, 55.0)
     alpha, beta = rayleigh_from_ratio(0.005, 1.0, 20.0)
@@ -125,7 +126,7 @@ def en50318(n_spans: int = 10, presag_max: float = 0.055) -> CatenaryDesign:
             "encumbrance": "choice: 1.2 m (not in the public data)",
             "EA of the wires": "choice: the 2015 benchmark's wires (E A = 15.0 MN and 11.64 MN)",
             "presag": f"choice: parabola, 0 at the end droppers, {1e3 * presag_max:g} mm at mid-span (55 mm is the "
-                      "public maximum)",
+                      "public maximum; the standard's Annex A presag is not in the public record)",
             "dropper and clamp masses": "choice: none (not in the public data)",
             "rayleigh": f"choice: alpha={alpha:.4g} 1/s, beta={beta:.4g} s give 0.5 % at 1 Hz and 20 Hz",
             "stagger": "choice: none",
