@@ -13,6 +13,12 @@
    elastic stretch under its tension.
 4. The assembled catenary with these droppers and support preloads is solved once more as a
    whole (a check: it must stay at the design height) and is the starting state of every run.
+
+With ``dropper_statics="strings"`` the dropper lengths and support forces of steps 1-3 are
+replaced by those of perfectly flexible wires (:func:`symcat.catenary.span_statics.section_statics`
+with ``bending=False``, the usual design calculation) before step 4; the model's wires, stiff in
+bending, then hold the contact wire a few millimetres off its design height, which
+``height_error_m`` reports.
 """
 from __future__ import annotations
 
@@ -46,7 +52,9 @@ class FormFindingResult:
         Unstretched lengths and static tensions of all droppers.
     height_error_m : float
         Largest deviation of the contact wire from its target height at the droppers and (with
-        ``steady_arm="held"``) the supports in the final coupled equilibrium.
+        ``steady_arm="held"``) the supports in the final coupled equilibrium: round-off for
+        ``dropper_statics="wires"``, millimetres for ``"strings"`` (the bending stiffness the
+        flexible-wire droppers leave out, and the mesh).
     iterations : int
         Contact/messenger iterations.
     wall_s : float
