@@ -16,7 +16,7 @@ benchmark2015_dropper_lengths.csv``, with its source), are reproduced within 1.4
 published values are in 1 mm steps) by the defaults:
 
 - ``steady_arm=free``: the steady arms carry no vertical force in the static state; the droppers
-  carry all of the contact wire's weight (the end droppers 193 N each, the others 48 to 55 N),
+  carry all of the contact wire's weight (the end droppers 193 N each, the others 47 to 55 N),
   the wire hangs freely across each support between the droppers on either side (6 mm below
   its design height there) and the steady-arm springs act only on motion. The presag is zero
   at the end droppers; the messenger supports are 1.2 m above the contact wire's design height.
