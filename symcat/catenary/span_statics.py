@@ -71,7 +71,7 @@ class _Line:
     def slope(self, k: int, s: float) -> float:
         """Slope on stretch ``k`` at local position ``s`` (-)."""
         e0, e1 = self._exp(k, s)
-        a0, a1, a2, a3 = self.coef[k]
+        _, a1, a2, a3 = self.coef[k]
         return a1 + self.lam * (-a2 * e0 + a3 * e1) + self.q[k] * s / self.H
 
     def shear(self, k: int, s: float) -> float:
@@ -109,7 +109,7 @@ class _Line:
         return np.array(out)
 
 
-def _end_rows(x, k, lam, s_end: bool, n):
+def _end_rows(x, k, lam, s_end: bool):
     """Coefficient rows of (w, w', w'', F/H) at the start (or end) of stretch ``k``."""
     l = x[k + 1] - x[k]
     e = math.exp(-l / lam)
@@ -160,12 +160,12 @@ def solve_line(x, pinned, z, load, q, wire_H: float, EI: float, periodic: bool) 
         vals.extend(v)
 
     for i in range(n):
-        c0, r0 = _end_rows(x, i, lam, False, n)
+        c0, r0 = _end_rows(x, i, lam, False)
         k0 = _constants(x, i, q, wire_H, False)
         base = 4 * i
         if i > 0 or periodic:
             j = (i - 1) % n
-            c1, r1 = _end_rows(x, j, lam, True, n)
+            c1, r1 = _end_rows(x, j, lam, True)
             k1 = _constants(x, j, q, wire_H, True)
             for m in range(3):  # w, w', w'' continuous across node i
                 put(base + m, list(c0) + list(c1), list(r0[m]) + list(-r1[m]))
@@ -181,7 +181,7 @@ def solve_line(x, pinned, z, load, q, wire_H: float, EI: float, periodic: bool) 
             b[base] = z[0] - k0[0]
             put(base + 1, c0, r0[2])
             b[base + 1] = -k0[2]
-            c1, r1 = _end_rows(x, n - 1, lam, True, n)
+            c1, r1 = _end_rows(x, n - 1, lam, True)
             k1 = _constants(x, n - 1, q, wire_H, True)
             put(base + 2, c1, r1[0])
             b[base + 2] = z[-1] - k1[0]
