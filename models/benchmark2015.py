@@ -10,6 +10,38 @@ Assumptions (the public parameter set marks them "(?)"): steady-arm and messenge
 stiffness, Rayleigh damping, pantograph dampers (0 unless set), uplift = EN 50367 mean force on
 the lower frame; stagger +/-0.2 m; contact-wire height 5.3 m; pantograph gravity balanced.
 
+Static conventions (issue 30). The benchmark's published dropper lengths, 1.017, 0.896, 0.810,
+0.758, 0.741 m from the support to mid-span (``symcat/reference_data/
+benchmark2015_dropper_lengths.csv``, with its source), are reproduced within 1.4 mm (the
+published values are in 1 mm steps) by the defaults:
+
+- ``steady_arm=free``: the steady arms carry no vertical force in the static state; the droppers
+  carry all of the contact wire's weight (the end droppers 193 N each, the others 47 to 55 N),
+  the wire hangs freely across each support between the droppers on either side (6 mm below
+  its design height there) and the steady-arm springs act only on motion. The presag is zero
+  at the end droppers; the messenger supports are 1.2 m above the contact wire's design height.
+- ``dropper_statics=strings``: the dropper lengths are cut as for perfectly flexible wires (the
+  usual design calculation). The model's wires are stiff in bending (EI 195 and 131.7 N m^2),
+  which over each messenger support holds the messenger up: with these droppers the contact
+  wire then hangs about 7 mm above its design height in the interior spans at 60 elements per
+  span (4 mm from the bending stiffness, the rest from the mesh), its presag kept within
+  0.1 mm; the end spans tilt to the anchors, which hold it at the design height.
+
+``steady_arm=held, dropper_statics=wires`` is symcat's earlier convention, a legitimate design
+of its own: the steady arm holds the wire at its design height (carrying 56 N), the droppers
+are form-found with the model's wires, and the contact wire hangs exactly at its design
+height; its droppers are 13 to 15 mm longer than the published ones. Of that, 7.8 to 8 mm is
+the steady arms' share of the weight (moved to the end droppers, it pulls the whole messenger
+down), 4.4 mm the wires' bending stiffness at the messenger supports, and 2.1 mm the form
+finding's mesh at 60 elements per span (C1 elements round the messenger's kinks at the
+supports and clamps; it falls below 0.1 mm from 240 elements per span). The independent
+statics in :mod:`symcat.catenary.span_statics` reproduces the form finding of either
+convention within 0.1 mm from 240 elements per span. Other assumptions move the lengths less
+or the wrong way (flexible wires, free steady arms): massless droppers +1.2 to +3.8 mm, no
+clamp masses +4 to +15 mm, a messenger of 1.07 kg/m +0.7 to +2.3 mm, a 1 kg steady arm
+-1.4 mm, an unpreloaded messenger support (5e5 N/m) -2.6 mm, the encumbrance measured to the
+contact wire's static height at the support -6 mm.
+
 ``pantograph=seo2005`` runs the seed paper's four-body pantograph instead (scene bodies on the
 multibody path, :mod:`symcat.interaction.scene_passage`; penalty contact, as the wire is
 staggered; one pantograph, one tension section): its plunger uplift is trimmed so that the static
@@ -19,6 +51,7 @@ aerodynamic ``c v^2`` on the pan-head), and the summary reports that uplift (``u
 from __future__ import annotations
 
 from symcat.catenary import benchmark2015
+from symcat.catenary.design import DROPPER_STATICS, STEADY_ARM_CONVENTIONS
 from symcat.errors import ParameterError
 from symcat.interaction.model_support import (
     NUMERICAL_PARAMETERS,
@@ -55,6 +88,12 @@ PARAMETERS = [
     Parameter("dropper_positions_m", "", "m", "dropper positions from the start of a span, comma-separated; "
               "empty: the benchmark's nine", text="comma-separated numbers inside the span, or nothing",
               check=numbers_check(minimum=0.0, empty=True)),
+    Parameter("steady_arm", "free", "", "static load of the steady arms: free (none; the droppers carry the "
+              "contact wire, as the benchmark's dropper lengths assume) or held (the steady arm holds the wire at its "
+              "design height at the support)", choices=STEADY_ARM_CONVENTIONS),
+    Parameter("dropper_statics", "strings", "", "dropper lengths: strings (cut as for flexible wires, as the "
+              "benchmark's) or wires (form-found with the model's wires: the contact wire hangs exactly at its design "
+              "height)", choices=DROPPER_STATICS),
     PANTOGRAPH_PARAMETER,
 ] + NUMERICAL_PARAMETERS
 
@@ -67,7 +106,7 @@ def design_from(p: dict):
 
     n_spans = p["n_spans"] or (10 if p["n_pantographs"] == 1 or p["tension_sections"] > 1 else
                                spans_needed(55.0, 2, p["spacing_m"], p["analysis_spans"]))
-    d = benchmark2015(n_spans)
+    d = benchmark2015(n_spans, steady_arm=p["steady_arm"], dropper_statics=p["dropper_statics"])
     changes = dict(presag=tuple(p["presag_scale"] * s for s in d.presag), n_sections=p["tension_sections"],
                    overlap_raise=p["overlap_raise_m"])
     changes["contact_wire"] = replace(d.contact_wire, tension=p["contact_wire_tension_N"])

@@ -8,7 +8,13 @@ stagger). The pantograph is the two-mass reference with a static force of 120 N 
 (public sources disagree; a parameter). ``symcat validate en50318`` runs both speeds and checks
 the statistics against the standard's ranges.
 
-The presag is the open value the result depends on most (60 elements/span, 1 ms, 120 N):
+The presag is an assumption. The standard's own Annex A data for the reference catenary's
+presag and dropper layout are not in the public record: a search of public papers, pages and
+code for issue 30 found only the dropper positions above and 55 mm given as the maximum
+presag, the codes that reproduce the model marking it an assumption too. The model takes a parabola through 0 at the end
+droppers with ``presag_mm`` at mid-span, 55 mm by default; ``symcat validate en50318`` states
+the value it used under its table. The presag is the open value the result depends on most
+(60 elements/span, 1 ms, 120 N):
 
 | presag | 250 km/h | 300 km/h |
 |---|---|---|
@@ -45,8 +51,9 @@ PARAMETERS = [
               minimum=0.0, exclusive_minimum=True),
     Parameter("static_force_N", 120.0, "N", "static force on the pantograph frame", minimum=0.0, exclusive_minimum=True),
     Parameter("n_spans", 10, "-", "spans of the line", minimum=4, maximum=200),
-    Parameter("presag_mm", 55.0, "mm", "contact-wire presag at mid-span (parabola, 0 at the end droppers); the "
-              "public data give 55 mm as the maximum, and the statistics are sensitive to it", minimum=0.0,
+    Parameter("presag_mm", 55.0, "mm", "contact-wire presag at mid-span (parabola, 0 at the end droppers): an "
+              "assumption, the standard's own presag is not in the public record; the public data give 55 mm as the "
+              "maximum, and the statistics are sensitive to it", minimum=0.0,
               maximum=200.0),
     PANTOGRAPH_PARAMETER,
 ] + NUMERICAL_PARAMETERS

@@ -1,9 +1,12 @@
 """``symcat validate en50318``: run the reference model at both speeds and check the ranges.
 
 The acceptance ranges are those of EN 50318:2002 Annex A (``symcat/reference_data/en50318.md``).
+The reference catenary's presag and dropper layout of Annex A are not in the public record
+(issue 30): the presag is an assumption, and the output always says so and which value it used.
 When quantities fail at the default presag, lines under the table name the presag as the
 parameter they hinge on and the command that passes, read from the presag table of
-``models/en50318.py`` (:func:`presag_hint`).
+``models/en50318.py`` (:func:`presag_hint`); otherwise one line states the presag used
+(:func:`presag_statement`).
 """
 from __future__ import annotations
 
@@ -68,7 +71,7 @@ def presag_hint(results: dict[int, list], presag_mm: float, default_mm: float, p
     if not failing or presag_mm != default_mm:
         return ""
     text = (f"the failing quantities hinge on presag_mm ({presag_mm:g} mm here, an assumption: public data give "
-            f"{default_mm:g} mm as a maximum)")
+            f"{default_mm:g} mm as a maximum); {ANNEX_A_PRESAG}")
     if passing_mm:
         text += (f";\n`symcat validate en50318 --set presag_mm={passing_mm[0]:g}` passes every quantity at both speeds "
                  "(table in models/en50318.py")
@@ -76,10 +79,30 @@ def presag_hint(results: dict[int, list], presag_mm: float, default_mm: float, p
     return text
 
 
+#: What the public record holds of the reference catenary's presag (issue 30's search).
+ANNEX_A_PRESAG = "the standard's own presag and dropper layout (Annex A) are not in the public record"
+
+
+def presag_statement(presag_mm: float, default_mm: float) -> str:
+    """The line under the table when :func:`presag_hint` has nothing to say: the presag this
+    validation used (mm at mid-span) is an assumption."""
+    which = "the model's default" if presag_mm == default_mm else f"set here; the default is {default_mm:g} mm"
+    return (f"presag_mm = {presag_mm:g} mm ({which}) is an assumption: {ANNEX_A_PRESAG}; public data give "
+            f"{default_mm:g} mm as a maximum, and the statistics depend on it (models/en50318.py)")
+
+
+def closing_lines(results: dict[int, list], presag_mm: float, default_mm: float, passing_mm: list[float],
+                  changed: list[str] = ()) -> str:
+    """What follows the table: the presag hint when quantities fail at the default presag
+    (:func:`presag_hint`), else the presag statement (:func:`presag_statement`)."""
+    return presag_hint(results, presag_mm, default_mm, passing_mm, changed) or presag_statement(presag_mm, default_mm)
+
+
 def validate_en50318(params: dict | None = None, out=None, progress: bool = True) -> tuple[str, bool, dict]:
-    """Run ``en50318`` at 250 and 300 km/h; returns (table, all passed, summaries). When
-    quantities fail at the default presag, a line under the table names the presag as the
-    parameter they hinge on and the documented command that passes (:func:`presag_hint`)."""
+    """Run ``en50318`` at 250 and 300 km/h; returns (table, all passed, summaries). Under the
+    table: when quantities fail at the default presag, the presag as the parameter they hinge
+    on and the documented command that passes (:func:`presag_hint`); otherwise the presag used
+    and that it is an assumption (:func:`presag_statement`)."""
     from pathlib import Path
 
     from .model import load_model, run_model
@@ -95,6 +118,6 @@ def validate_en50318(params: dict | None = None, out=None, progress: bool = True
     passed = all(r[4] for rows in results.values() for r in rows)
     table = format_table(results)
     changed = [k for k in (params or {}) if k not in ("presag_mm", "paraview", "progress", "speed_kmh")]
-    hint = presag_hint(results, model.resolve(params)["presag_mm"], model.parameter("presag_mm").default,
-                       passing_presags(model.run.__globals__.get("__doc__") or ""), changed)
-    return table + ("\n" + hint if hint else ""), passed, summaries
+    lines = closing_lines(results, model.resolve(params)["presag_mm"], model.parameter("presag_mm").default,
+                          passing_presags(model.run.__globals__.get("__doc__") or ""), changed)
+    return table + "\n" + lines, passed, summaries

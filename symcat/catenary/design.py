@@ -13,6 +13,12 @@ import numpy as np
 
 from ..errors import ParameterError
 
+#: How the contact wire's weight near a support is carried in the static state (see
+#: ``CatenaryDesign.steady_arm``).
+STEADY_ARM_CONVENTIONS = ("held", "free")
+#: How the dropper lengths are found (see ``CatenaryDesign.dropper_statics``).
+DROPPER_STATICS = ("wires", "strings")
+
 
 def _positive(name: str, value: float, unit: str) -> None:
     if not (np.isfinite(value) and value > 0):
@@ -98,6 +104,22 @@ class CatenaryDesign:
         Vertical stiffness of the contact-wire support (steady arm) (N/m).
     steady_arm_mass : float
         Mass of the steady arm lumped on the contact wire at the support (kg).
+    steady_arm : str
+        How the static state shares the contact wire's weight between steady arms and droppers.
+        ``"held"``: the steady arm holds the contact wire at its design height at every support
+        and carries whatever vertical force that takes (its spring is preloaded). ``"free"``: the
+        steady arm carries no vertical force in the static state (its spring is unloaded there
+        and acts only on motion); the droppers carry all the wire's weight, and the wire hangs
+        freely between the last dropper of a span and the first of the next, a few millimetres
+        below its design height at the support. The messenger support is ``encumbrance`` above
+        the contact wire's design height at the support in both.
+    dropper_statics : str
+        How the dropper lengths are found. ``"wires"``: by form finding with the model's own
+        wires (bending stiffness included), so the static contact wire hangs exactly at its
+        design height. ``"strings"``: cut as for perfectly flexible wires, the usual design
+        calculation (:func:`symcat.catenary.span_statics.section_statics` with
+        ``bending=False``); the model's wires, stiff in bending over the messenger supports,
+        then hold the contact wire a few millimetres above its design height, its presag kept.
     messenger_support_stiffness : float
         Vertical stiffness of the messenger support (N/m).
     stagger : float
@@ -134,6 +156,8 @@ class CatenaryDesign:
     clamp_mass_messenger: float = 0.0
     steady_arm_stiffness: float = 2000.0
     steady_arm_mass: float = 0.0
+    steady_arm: str = "held"
+    dropper_statics: str = "wires"
     messenger_support_stiffness: float = 1.0e6
     stagger: float = 0.0
     contact_wire_height: float = 5.3
@@ -176,6 +200,10 @@ class CatenaryDesign:
                            ("rayleigh_alpha", "1/s"), ("rayleigh_beta", "s"), ("gravity", "m/s^2")):
             _non_negative(name, getattr(self, name), unit)
         _positive("steady_arm_stiffness", self.steady_arm_stiffness, "N/m")
+        if self.steady_arm not in STEADY_ARM_CONVENTIONS:
+            raise ParameterError(f"steady_arm={self.steady_arm!r}: must be one of {', '.join(STEADY_ARM_CONVENTIONS)}")
+        if self.dropper_statics not in DROPPER_STATICS:
+            raise ParameterError(f"dropper_statics={self.dropper_statics!r}: must be one of {', '.join(DROPPER_STATICS)}")
         _positive("messenger_support_stiffness", self.messenger_support_stiffness, "N/m")
         if not abs(self.stagger) < 0.1 * self.span_length:
             raise ParameterError(f"stagger={self.stagger:g} m: must be smaller than a tenth of the span")

@@ -1,8 +1,11 @@
 """Static form finding: dropper lengths that make the contact wire hang at its design height.
 
-1. The contact wire alone, held at its target height at every dropper and support, carries its
-   weight, the clamps and half of each dropper; the vertical reactions there are the dropper
-   tensions and the steady-arm preloads.
+1. The contact wire alone, held at its target height at every dropper and (with the design's
+   ``steady_arm="held"``) at every support, carries its weight, the clamps and half of each
+   dropper; the vertical reactions there are the dropper tensions and the steady-arm preloads.
+   With ``steady_arm="free"`` the steady arms carry nothing in the static state: the wire hangs
+   freely across each support between the droppers on either side, and the steady-arm springs
+   are set unloaded at the height it takes there.
 2. The messenger, held at the supports, carries its weight and those dropper tensions; its
    shape gives the dropper directions and lengths.
 3. Steps 1-2 repeat with the dropper directions (not quite vertical once the wires stretch)
@@ -10,6 +13,12 @@
    elastic stretch under its tension.
 4. The assembled catenary with these droppers and support preloads is solved once more as a
    whole (a check: it must stay at the design height) and is the starting state of every run.
+
+With ``dropper_statics="strings"`` the dropper lengths and support forces of steps 1-3 are
+replaced by those of perfectly flexible wires (:func:`symcat.catenary.span_statics.section_statics`
+with ``bending=False``, the usual design calculation) before step 4; the model's wires, stiff in
+bending, then hold the contact wire a few millimetres off its design height, which
+``height_error_m`` reports.
 """
 from __future__ import annotations
 
@@ -42,8 +51,10 @@ class FormFindingResult:
     dropper_length_m, dropper_tension_N : ndarray
         Unstretched lengths and static tensions of all droppers.
     height_error_m : float
-        Largest deviation of the contact wire from its target height at the droppers and
-        supports in the final coupled equilibrium.
+        Largest deviation of the contact wire from its target height at the droppers and (with
+        ``steady_arm="held"``) the supports in the final coupled equilibrium: round-off for
+        ``dropper_statics="wires"``, millimetres for ``"strings"`` (the bending stiffness the
+        flexible-wire droppers leave out, and the mesh).
     iterations : int
         Contact/messenger iterations.
     wall_s : float
@@ -113,18 +124,21 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
         lengths, iterations = [], 0
         for k, sec in enumerate(st.sections):
             out = _form_section(st, k, tol, max_iterations, status)
+            if design.dropper_statics == "strings":
+                out = _string_droppers(design, k, out)
             lengths.append(out[0])
             rows = slice(k * n_inner, (k + 1) * n_inner)
             st.cw_supports.preload[rows], st.mw_supports.preload[rows], st.mw_supports.height[rows] = out[1:4]
-            iterations = max(iterations, out[4])
+            st.cw_supports.height[rows] = out[4]
+            iterations = max(iterations, out[5])
         length0 = np.concatenate(lengths)
         st._build_system()
         st.set_dropper_lengths(length0)
         status.show("the static equilibrium of the whole line")
-        q = coupled_equilibrium(st, st.q0)
+        q = _static_state(st)
     finally:
         status.close()
-    nodes = np.concatenate([st.dropper_nodes, st.cw_supports.nodes])
+    nodes = st.dropper_nodes if design.steady_arm == "free" else np.concatenate([st.dropper_nodes, st.cw_supports.nodes])
     height_error = float(np.max(np.abs(st.contact_wire_z(q)[nodes] - st.target_z[nodes])))
     _, _, tension = st.dropper_state(q)
     return FormFindingResult(st, q, length0, tension, height_error, iterations, time.perf_counter() - t0)
@@ -132,13 +146,14 @@ def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "ca
 
 def _form_section(st: CatenaryStructure, k: int, tol: float, max_iterations: int, status: Status | None = None):
     """Form finding of tension section ``k`` (steps 1-3); returns the unstretched dropper
-    lengths, the steady-arm and messenger-support preloads, the messenger support heights and
-    the number of iterations."""
+    lengths, the steady-arm and messenger-support preloads, the messenger support heights, the
+    contact-wire heights at the inner supports and the number of iterations."""
     d = st.design
     sec = st.sections[k]
     cw_body, mw_body = st.contacts[k], st.messengers[k]
     drop, sup = st._local["drop"], st._local["support"]
     inner = sup[1:-1]
+    held = d.steady_arm == "held"
     n_nodes = cw_body.n_nodes
     pos = lambda nodes: nodes[:, :3]
     direction = np.tile([0.0, 0.0, 1.0], (drop.size, 1))
@@ -153,9 +168,9 @@ def _form_section(st: CatenaryStructure, k: int, tol: float, max_iterations: int
             change = f": dropper lengths changed by {last_change:.2g} m (to converge: {tol:g} m)" if iteration > 1 else ""
             status.show(f"{sections}iteration {iteration}{change}")
         half = 0.5 * d.dropper_mass_per_length * length0 * d.gravity
-        # 1. contact wire held at the design height at droppers and supports
+        # 1. contact wire held at the design height at the droppers (and supports if held)
         fixed = [(0, ["x", "y", "z"] + beam_extra), (n_nodes - 1, ["x", "y", "z"])]
-        fixed += [(j, ["x", "y", "z"]) for j in inner] + [(j, ["x", "z"]) for j in drop]
+        fixed += [(j, ["x", "y", "z"] if held else ["x", "y"]) for j in inner] + [(j, ["x", "z"]) for j in drop]
         fixed += [(j, ["x"]) for j in np.setdiff1d(np.arange(1, n_nodes - 1), np.concatenate([inner, drop]))]
         loads = [(n_nodes - 1, (d.contact_wire.tension, 0.0, 0.0))]
         for j, node in enumerate(drop):
@@ -200,9 +215,40 @@ def _form_section(st: CatenaryStructure, k: int, tol: float, max_iterations: int
         _balance_axial_forces(cw_body, cw, cw_react[:, 0], d.contact_wire)
         _balance_axial_forces(mw_body, mw, mw_react[:, 0], d.messenger_wire)
         if last_change < tol:
-            return length0, cw_react[inner, 2].copy(), mw_react[inner, 2].copy(), mw[inner, 2].copy(), iteration
+            steady = cw_react[inner, 2].copy() if held else np.zeros(inner.size)
+            return length0, steady, mw_react[inner, 2].copy(), mw[inner, 2].copy(), cw[inner, 2].copy(), iteration
     raise SolverError(f"form finding: dropper lengths of tension section {k + 1} still changed by {last_change:.3g} m "
                       f"after {max_iterations} iterations (tol={tol:g} m)")
+
+
+def _string_droppers(design: CatenaryDesign, k: int, wires: tuple) -> tuple:
+    """Replace the wire-based results of :func:`_form_section` for section ``k`` by the dropper
+    lengths and support forces of flexible strings (``dropper_statics="strings"``); the
+    messenger support heights and the iteration count stay."""
+    from .span_statics import section_statics
+
+    s = section_statics(design, k, bending=False)
+    return (s.dropper_length_m, s.steady_arm_force_N, s.messenger_support_force_N, wires[3],
+            s.contact_wire_support_z_m, wires[5])
+
+
+def _static_state(st: CatenaryStructure) -> np.ndarray:
+    """Static equilibrium of the assembled catenary with its dropper lengths and support preloads.
+
+    With ``steady_arm="free"`` the steady arms must carry nothing here: the equilibrium is
+    solved without their springs, which are then set unloaded at the heights found.
+    """
+    if st.design.steady_arm == "held":
+        return coupled_equilibrium(st, st.q0)
+    stiffness = st.cw_supports.stiffness
+    st.cw_supports.stiffness = 0.0
+    try:
+        q = coupled_equilibrium(st, st.q0)
+    finally:
+        st.cw_supports.stiffness = stiffness
+    st.cw_supports.height[:] = q[st.cw_xyz[st.cw_supports.nodes, 2]]
+    st.cw_supports.preload[:] = 0.0
+    return q
 
 
 def coupled_equilibrium(structure: CatenaryStructure, q: np.ndarray, extra=None, rtol: float = 1e-10,

@@ -6,6 +6,9 @@ are marked "choice" with the reason (see ``symcat/reference_data/*.md``).
 from __future__ import annotations
 
 import math
+from importlib import resources
+
+import numpy as np
 
 from .design import CatenaryDesign, Wire
 
@@ -28,8 +31,22 @@ def rayleigh_from_ratio(zeta: float, f1_hz: float, f2_hz: float) -> tuple[float,
     return 2 * zeta * w1 * w2 / (w1 + w2), 2 * zeta / (w1 + w2)
 
 
-def benchmark2015(n_spans: int = 10) -> CatenaryDesign:
-    """The pantograph-catenary interaction benchmark catenary (Bruni et al. 2015)."""
+def benchmark2015(n_spans: int = 10, steady_arm: str = "held", dropper_statics: str = "wires") -> CatenaryDesign:
+    """The pantograph-catenary interaction benchmark catenary (Bruni et al. 2015).
+
+    Parameters
+    ----------
+    n_spans : int
+        Spans of the tension section.
+    steady_arm, dropper_statics : str
+        Static conventions (:class:`~symcat.catenary.design.CatenaryDesign`). The benchmark's
+        published dropper lengths (:func:`benchmark2015_dropper_lengths`) follow
+        ``steady_arm="free", dropper_statics="strings"``: the model ``benchmark2015`` uses
+        those. The defaults here keep the convention other models built on this catenary use
+        (``seo2005_line``): steady arms holding the wire at its design height, droppers
+        form-found with the model's wires (13 to 15 mm longer than the published ones at 60
+        elements per span).
+    """
     positions = (4.5, 10.25, 16.0, 21.75, 27.5, 33.25, 39.0, 44.75, 50.5)
     return CatenaryDesign(
         n_spans=n_spans,
@@ -48,13 +65,32 @@ def benchmark2015(n_spans: int = 10) -> CatenaryDesign:
         stagger=0.2,
         rayleigh_alpha=0.0125,
         rayleigh_beta=1.0e-4,
+        steady_arm=steady_arm,
+        dropper_statics=dropper_statics,
         sources={
             "all values": BENCHMARK_2015_SOURCE + " (public parameter set, symcat/reference_data/catenary-benchmark-2015.md)",
+            "steady_arm, dropper_statics": "free, strings reproduce the benchmark's nominal dropper lengths within 1.4 mm "
+                                           "(symcat/reference_data/benchmark2015_dropper_lengths.csv); held, wires: "
+                                           "symcat's earlier convention",
             "steady_arm_stiffness, messenger_support_stiffness, rayleigh": "single secondary source (?), an assumption",
             "stagger": "choice: +/-0.2 m, a usual high-speed value; the public set does not state it",
             "contact_wire_height": "choice: 5.3 m; only relative heights matter",
         },
     )
+
+
+def benchmark2015_dropper_lengths() -> dict[str, np.ndarray]:
+    """The benchmark's published dropper lengths of one span, with their positions and presag.
+
+    Read from ``symcat/reference_data/benchmark2015_dropper_lengths.csv`` (its header gives the
+    source). Returns arrays ``position_m``, ``presag_m`` and ``length_m`` (m, dropper 1 nearest
+    the span's first support).
+    """
+    text = resources.files("symcat.reference_data").joinpath("benchmark2015_dropper_lengths.csv").read_text()
+    rows = [line for line in text.splitlines() if line and not line.startswith("#")]
+    header = rows[0].split(",")
+    table = np.array([[float(v) for v in row.split(",")] for row in rows[1:]])
+    return {name: table[:, header.index(name)] for name in ("position_m", "presag_m", "length_m")}
 
 
 def en50318(n_spans: int = 10, presag_max: float = 0.055) -> CatenaryDesign:
@@ -65,7 +101,8 @@ def en50318(n_spans: int = 10, presag_max: float = 0.055) -> CatenaryDesign:
     clamp masses (none given: taken as zero), Rayleigh damping fitted to 0.5 % at 1 and 20 Hz,
     and no stagger. ``presag_max`` (m) is the presag at mid-span: the public data give 55 mm
     as a maximum, and the statistics depend on it more than on any other open value (the
-    sensitivity study in ``models/en50318.py``).
+    sensitivity study in ``models/en50318.py``). The standard's own presag and dropper layout
+    (Annex A) are not in the public record (issue 30), so the presag stays an assumption.
     """
     positions = (5.0, 10.5, 17.0, 23.5, 30.0, 36.5, 43.0, 49.5, 55.0)
     alpha, beta = rayleigh_from_ratio(0.005, 1.0, 20.0)
@@ -89,7 +126,7 @@ def en50318(n_spans: int = 10, presag_max: float = 0.055) -> CatenaryDesign:
             "encumbrance": "choice: 1.2 m (not in the public data)",
             "EA of the wires": "choice: the 2015 benchmark's wires (E A = 15.0 MN and 11.64 MN)",
             "presag": f"choice: parabola, 0 at the end droppers, {1e3 * presag_max:g} mm at mid-span (55 mm is the "
-                      "public maximum)",
+                      "public maximum; the standard's Annex A presag is not in the public record)",
             "dropper and clamp masses": "choice: none (not in the public data)",
             "rayleigh": f"choice: alpha={alpha:.4g} 1/s, beta={beta:.4g} s give 0.5 % at 1 Hz and 20 Hz",
             "stagger": "choice: none",
