@@ -16,7 +16,12 @@ def test_benchmark_static_summary_has_dropper_lengths(tmp_path):
     assert len(lengths) == 9
     assert lengths == pytest.approx(lengths[::-1], abs=2e-3)
     assert 0.7 < min(lengths) < max(lengths) < 1.1
-    assert res.summary["form_finding_height_error_m"] < 1e-8
+    # the default cuts the droppers as for flexible wires (the benchmark's published lengths):
+    # the model's stiffer wires hold the contact wire a few millimetres above the design height
+    assert 1e-3 < res.summary["form_finding_height_error_m"] < 1e-2
+    held = run_model("benchmark2015", {"t_end": 0.0, "progress": False, "steady_arm": "held",
+                                       "dropper_statics": "wires"})
+    assert held.summary["form_finding_height_error_m"] < 1e-8  # form-found with the model's own wires
     assert res.summary["simulated_s"] == 0.0 and "wall_s" in res.summary
     assert json.loads((tmp_path / "summary.json").read_text())["model"] == "benchmark2015"
 
