@@ -19,10 +19,12 @@ from symcat.pantograph import benchmark2015_pantograph
 KEYS = ("contact_force_mean_N", "contact_force_std_N", "contact_force_max_N", "contact_force_min_N",
         "support_uplift_max_m", "contact_loss_percent")
 SPEED = 320 / 3.6
+#: The model benchmark2015's static convention (the benchmark's published dropper lengths).
+CONVENTION = dict(steady_arm="free", dropper_statics="strings")
 
 
 def _run(elements=60, dt=1e-3, tol=1e-4, n_spans=10, t_end=None, repeats=1, wires="nonlinear"):
-    design = benchmark2015(n_spans)
+    design = benchmark2015(n_spans, **CONVENTION)
     form = find_form(design, elements)
     walls, res = [], None
     for _ in range(repeats):
@@ -62,7 +64,7 @@ def hard_cases() -> list[str]:
                                                                    analysis_spans=3)),
     ]
     for label, c in cases:
-        design = benchmark2015(c["n_spans"]).with_(n_sections=c.get("sections", 1))
+        design = benchmark2015(c["n_spans"], **CONVENTION).with_(n_sections=c.get("sections", 1))
         panto = benchmark2015_pantograph(320)
         t0 = time.perf_counter()
         res = run_passage(design, [panto] * c["pantographs"], c["speed_kmh"] / 3.6, elements_per_span=60, dt=1e-3,
@@ -91,6 +93,39 @@ def hard_cases() -> list[str]:
     ]
 
 
+def unified_paths(repeats: int = 3) -> list[str]:
+    """The model benchmark2015 on the interaction path (``pantograph=lumped``) and on the shared
+    multibody path (``lumped_scene``: the same pantograph as scene bodies, generalized-alpha on
+    the catenary scene), interleaved runs, medians of ``repeats``: statistics apart and the
+    ratio of wall per simulated second (static placement excluded)."""
+    from symcat.model import run_model
+
+    cases = [("defaults (60 elements/span, dt 1 ms, tol 1e-4 m)", {}),
+             ("1 % settings (50 elements/span, dt 2 ms, tol 1e-3 m, linear wires)",
+              dict(elements_per_span=50, dt=2e-3, tol=1e-3, wires="linear")),
+             ("overlap of two 10-span sections (3 spans analysed)", dict(tension_sections=2, analysis_spans=3)),
+             ("two pantographs 200 m apart, 275 km/h", dict(n_pantographs=2, speed_kmh=275.0))]
+    lines = ["| case | mean apart [N] | std apart [N] | max apart [N] | interaction [s/s] | multibody [s/s] | "
+             "ratio |", "|---|---:|---:|---:|---:|---:|---:|"]
+    for label, params in cases:
+        walls = {"lumped": [], "lumped_scene": []}
+        stats = {}
+        for _ in range(repeats):
+            for path in walls:
+                out = run_model("benchmark2015", {**params, "pantograph": path, "progress": False, "paraview": False})
+                walls[path].append(out.summary["wall_per_simulated_s"])
+                summary = out.summary.get("pantograph_1", out.summary)
+                stats[path] = {k: summary[k] for k in ("contact_force_mean_N", "contact_force_std_N",
+                                                       "contact_force_max_N")}
+        a, b = stats["lumped"], stats["lumped_scene"]
+        wa, wb = statistics.median(walls["lumped"]), statistics.median(walls["lumped_scene"])
+        lines.append(f"| {label} | {abs(b['contact_force_mean_N'] - a['contact_force_mean_N']):.3f} | "
+                     f"{abs(b['contact_force_std_N'] - a['contact_force_std_N']):.3f} | "
+                     f"{abs(b['contact_force_max_N'] - a['contact_force_max_N']):.2f} | {wa:.2f} | {wb:.2f} | "
+                     f"{wb / wa:.2f} |")
+    return lines
+
+
 def section(report_dir: Path) -> list[str]:
     header = ["| run | mean [N] | std [N] | max [N] | min [N] | uplift | loss [%] | wall / simulated |",
               "|---|---:|---:|---:|---:|---:|---:|---:|"]
@@ -103,6 +138,7 @@ def section(report_dir: Path) -> list[str]:
     fast = [(w, *_run(elements=50, dt=2e-3, tol=1e-3, wires=w, repeats=3)) for w in ("nonlinear", "linear")]
     spans = [(n, *_run(n_spans=n, t_end=0.5, repeats=3)) for n in (10, 20, 40)]
     hard = hard_cases()
+    unified = unified_paths()
     lines = [
         "## Pantograph/catenary: benchmark2015 at 320 km/h (one pantograph, penalty contact)",
         "",
@@ -153,6 +189,15 @@ def section(report_dir: Path) -> list[str]:
         *[f"| {n} | {res.line.n} | {r:.2f} |" for n, s, r, res in spans],
         "",
         *hard,
+        "",
+        "### The shared multibody path against the interaction path (model benchmark2015, 320 km/h unless stated)",
+        "",
+        "The lumped pantograph as scene bodies under the catenary scene, integrated by the shared generalized-alpha "
+        "(`pantograph=lumped_scene`), against the interaction path (`pantograph=lumped`): statistics apart (the "
+        "last run of each) and wall time per simulated second (medians of 3 interleaved runs; ratio multibody / "
+        "interaction).",
+        "",
+        *unified,
     ]
     return lines
 

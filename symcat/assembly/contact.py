@@ -33,7 +33,8 @@ def add_contact(model, contact: PenaltyContact):
 
 def contact_terms(model, q: ca.MX, v: ca.MX, s_c: ca.MX) -> dict:
     """Generalized contact forces ``Q`` (n_q), tangency residuals ``T``, gaps (m) and normal
-    forces (N) of every contact (MX)."""
+    forces (N) of every contact (MX). Off its wire (past an end) a contact's gap is measured to
+    the wire's straight continuation and its force is zero."""
     q_total = ca.MX(model.n_q, 1)
     t_parts, gaps, forces = [], [], []
     for k, ct in enumerate(model.contacts):
@@ -42,6 +43,10 @@ def contact_terms(model, q: ca.MX, v: ca.MX, s_c: ca.MX) -> dict:
         p = ca.vertcat(length, ca.DM(ct.params[1:]))
         t_parts.append(lib[f"{ct.library}_tangency"](y, p))
         q_loc, gap, force = lib[f"{ct.library}_force"](y, y_dot[:-1], p)
+        # Past the wire's ends the point follows its straight continuation (the tangency stays
+        # solvable, see ElementWindows._selection) but touches nothing: the wire has ended.
+        on_wire = ca.logic_and(s_c[k] >= ct.element_start[0], s_c[k] <= ct.element_start[-1])
+        q_loc, force = q_loc * on_wire, force * on_wire
         n_loc = ct.element_indices.shape[1]
         rows = model._rigid_indices(ct.body.name)
         q_total += ca.mtimes(sel.T, q_loc[:n_loc])

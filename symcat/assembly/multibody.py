@@ -76,7 +76,10 @@ def wire_attachment(scene, kind: str, name: str, wire_name: str, body_name: str,
     if wire.element.name not in ("cable3d", "beam3d"):
         raise ParameterError(f"{kind} {name!r}: wire {wire.name!r} is {wire.element.name}; a {kind} needs cable3d or beam3d")
     starts = np.concatenate([[0.0], np.cumsum(wire.params[:, 0])])
-    if not 0 <= s0 <= starts[-1]:
+    if kind == "contact":  # a contact may start on the wire's straight continuation past an end
+        if not np.isfinite(s0):
+            raise ParameterError(f"{kind} {name!r}: s0={s0!r} m must be a finite arc length")
+    elif not 0 <= s0 <= starts[-1]:
         raise ParameterError(f"{kind} {name!r}: s0={s0:g} m must lie on the wire, in [0, {starts[-1]:g}] m")
     return wire, body, starts
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import casadi as ca
 import numpy as np
+import scipy.sparse as sps
 
 
 class ElementWindows:
@@ -60,25 +61,82 @@ class ElementWindows:
     def _selection(self, sl, s: ca.MX):
         """Sparse ``Sel(s)`` with ``e = Sel q`` the coordinates of the element containing ``s``
         (within the window), and that element's start and length. The masks are piecewise
-        constant in ``s`` (zero derivative), so one sparse product carries the chain rule."""
+        constant in ``s`` (zero derivative), so one sparse product carries the chain rule.
+
+        Past a wire's free end (``s`` below 0 or above its length, the window at that end) the
+        point is on the wire's straight continuation along its end tangent
+        (:func:`extension_rows`): a contact can then follow a pan-head that has left a wire
+        (the wire of the next tension section, raised towards its anchor), with the closest
+        point defined everywhere, instead of a cubic extrapolated far beyond its element."""
         lo, hi = sl.window
-        masks = []
-        for k in range(lo, hi):
-            below = s >= sl.element_start[k] if k > lo else ca.MX(1)
-            above = s < sl.element_start[k + 1] if k < hi - 1 else ca.MX(1)
-            masks.append(ca.logic_and(below, above))
-        masks = ca.vertcat(*masks)
+        n_el = len(sl.element_start) - 1
         n_loc = sl.element_indices.shape[1]
-        rows = np.tile(np.arange(n_loc), hi - lo)
-        cols = sl.element_indices[lo:hi].ravel()
-        order = np.lexsort((rows, cols))  # CSC order: by column, then row
-        pattern = ca.Sparsity.triplet(n_loc, self.n_q, rows[order].tolist(), cols[order].tolist())
-        values = ca.repmat(masks.T, n_loc, 1)  # entry (r, k): mask of window element k
-        values = ca.vec(values)[order.tolist()]
+        before, after = lo == 0, hi == n_el
+        masks, triplets = [], []  # triplets: (local row, global column, weight) per window element
+        for k in range(lo, hi):
+            below = s >= sl.element_start[k] if k > lo or before else ca.MX(1)
+            above = s < sl.element_start[k + 1] if k < hi - 1 or after else ca.MX(1)
+            masks.append(ca.logic_and(below, above))
+            triplets.append((np.arange(n_loc), sl.element_indices[k], np.ones(n_loc)))
+        starts = list(sl.element_start[lo:hi])
+        lengths = list(np.diff(sl.element_start)[lo:hi])
+        dim = sl.wire.element.dim
+        reach = extension_length(sl.element_start)
+        if before:
+            masks.append(s < sl.element_start[0])
+            triplets.append(extension_rows(sl.element_indices[0], dim, at_end=False, length=reach))
+            starts.append(sl.element_start[0] - reach)
+            lengths.append(reach)
+        if after:
+            masks.append(s >= sl.element_start[n_el])
+            triplets.append(extension_rows(sl.element_indices[n_el - 1], dim, at_end=True, length=reach))
+            starts.append(sl.element_start[n_el])
+            lengths.append(reach)
+        masks = ca.vertcat(*masks)
+        rows = np.concatenate([t[0] for t in triplets])
+        cols = np.concatenate([t[1] for t in triplets])
+        weights = np.concatenate([t[2] for t in triplets])
+        owner = np.concatenate([np.full(t[0].size, e) for e, t in enumerate(triplets)])
+        # Sel = sum over window elements of mask_e * Sel_e: a (row, column) shared by two of them
+        # (a common node; the end node of a wire and its continuation) sums their entries.
+        keys, inverse = np.unique(cols * n_loc + rows, return_inverse=True)  # CSC order: by column, then row
+        weight_of = sps.csr_matrix((weights, (inverse, owner)), shape=(keys.size, len(triplets)))
+        pattern = ca.Sparsity.triplet(n_loc, self.n_q, (keys % n_loc).tolist(), (keys // n_loc).tolist())
+        values = ca.mtimes(ca.DM(weight_of), masks)
         sel = ca.sparsity_cast(values, pattern)
-        start = ca.dot(masks, ca.DM(sl.element_start[lo:hi]))
-        length = ca.dot(masks, ca.DM(np.diff(sl.element_start)[lo:hi]))
+        start = ca.dot(masks, ca.DM(starts))
+        length = ca.dot(masks, ca.DM(lengths))
         override = self.element_override.get(id(sl))
         if override is not None:  # a stand-in element: the actual one's start and length given
             start, length = override
         return sel, start, length
+
+
+def extension_length(element_start: np.ndarray) -> float:
+    """Length (m) of the element that stands for a wire's straight continuation: twice the
+    wire, so that a point up to a wire length past the end sits at ``xi <= 1/2`` (the Hermite
+    shape functions of a far-extrapolated ``xi`` lose the straight line to round-off)."""
+    return 2.0 * float(element_start[-1] - element_start[0])
+
+
+def extension_rows(element: np.ndarray, dim: int, at_end: bool, length: float):
+    """The element coordinates ``(rows, columns, weights)`` of a wire's straight continuation
+    past its end (``at_end``) or its start, as one element of ``length`` beside the real end
+    element ``element`` (its global coordinate indices, two nodes of position then gradients).
+
+    A cubic Hermite element whose nodes have the same gradient ``r'`` and positions ``length r'``
+    apart is exactly the straight line ``r_end + (s - s_end) r'``; its coordinates are linear in
+    the end node's: the far node's position is ``r_end +/- length r'``, every other coordinate a
+    copy. Coordinates that are fixed stay in ``q`` with their values, so the map needs no
+    constant."""
+    n_loc = element.size
+    half = n_loc // 2
+    node = element[half:] if at_end else element[:half]
+    rows, cols, weights = [], [], []
+    for side in (0, 1):  # the virtual element's two nodes
+        far = side == 1 if at_end else side == 0
+        for i in range(half):
+            rows.append(side * half + i), cols.append(node[i]), weights.append(1.0)
+            if far and i < dim:  # position: plus (or minus) length times the gradient
+                rows.append(side * half + i), cols.append(node[dim + i]), weights.append(length if at_end else -length)
+    return np.array(rows), np.array(cols), np.array(weights)

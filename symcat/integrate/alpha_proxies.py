@@ -18,7 +18,12 @@ class Proxies:
     (interior, all coordinates free, touched by nothing else of the rest, proxies two elements
     apart) whose start and length are inputs; each evaluation writes the actual element's
     coordinates and step data into the proxy's places, and the results at the proxy's rows and
-    columns are moved back to the actual element's (dropping fixed coordinates)."""
+    columns are moved back to the actual element's (dropping fixed coordinates).
+
+    The actual element may also be a wire's straight continuation past one of its ends
+    (:func:`~symcat.assembly.windows.extension_rows`), whose coordinates are linear
+    combinations of the end node's: each proxy coordinate is a weighted sum of actual ones
+    (:class:`ElementMap`), and results move back by its transpose."""
 
     def __init__(self, step, items, elements):
         form = step.form
@@ -29,6 +34,7 @@ class Proxies:
         n_sliding = len(model.sliding)
         self.n_u = step.n_u
         self._model = model
+        self._y_of_q, self._q_fixed = y_of_q, q_fixed
         self.items = []
         for i, (sl, j) in enumerate(zip(items, elements)):
             where = form.n_f + i if i < n_sliding else step.n_y - step.n_sc + (i - n_sliding)
@@ -103,62 +109,124 @@ class Proxies:
 
         self._columns = (y_columns, p_columns)
         self._elements: dict[int, dict] = {}
+        # y index -> (item, position in its proxy element) of the proxies' coordinates
+        top = max(int(index[j].max()) for (_, j, index, _, _) in self.items) + 1
+        self._owner, self._local = np.full(top, -1), np.zeros(top, int)
+        for i, (_, j, index, _, _) in enumerate(self.items):
+            self._owner[index[j]], self._local[index[j]] = i, np.arange(index[j].size)
         self._starts = [np.asarray(sl.element_start, float).tolist() for (sl, *_) in self.items]
         self._places = [(at(y_at, index[j]), [at(p_at, index[j] + block * n_u) for block in range(3)])
                         for (_, j, index, _, _) in self.items]
 
+    def expand(self, maps, index: np.ndarray):
+        """Entries at y indices ``index`` re-expressed on the actual elements of ``maps`` (one
+        :class:`ElementMap` per item, as :meth:`substitute` returns them): ``(position in
+        index, y index, weight)`` per term; an index of no proxy stays (weight 1). All maps at
+        once: an actual element may be another item's proxy element."""
+        inside = index < self._owner.size
+        at = np.where(inside, index, 0)
+        item = np.where(inside, self._owner[at], -1)
+        local = self._local[at]
+        positions, actuals, weights = [np.flatnonzero(item < 0)], [], []
+        actuals.append(index[positions[0]])
+        weights.append(np.ones(positions[0].size))
+        for i, m in enumerate(maps):
+            mine = np.flatnonzero(item == i)
+            if mine.size:
+                at_term, actual, weight = m.terms(local[mine])
+                positions.append(mine[at_term]), actuals.append(actual), weights.append(weight)
+        return np.concatenate(positions), np.concatenate(actuals), np.concatenate(weights)
+
     def substitute(self, y, p):
         """The rest's inputs ``y[y_columns]`` and ``p[p_columns]`` (:meth:`restrict`) with each
         proxy's places holding its actual element's values, the elements' start and length
-        ``w``, and the maps ``(proxy, actual)`` of y indices."""
+        ``w``, and the :class:`ElementMap` of each proxy."""
         y_columns, p_columns = self._columns
         y_rest, p_rest = y[y_columns], p[p_columns]
         w = np.empty(2 * len(self.items))
         maps = []
         for i, (*_, where) in enumerate(self.items):
             starts = self._starts[i]
-            k = min(max(bisect.bisect_right(starts, float(y[where])) - 1, 0), len(starts) - 2)
-            proxy, actual, (y_to, y_from, y_fixed, y_values), (p_to, p_from, p_fixed, p_values) = self._element(i, k)
-            y_rest[y_to] = y[y_from]
-            y_rest[y_fixed] = y_values
-            p_rest[p_to] = p[p_from]
-            p_rest[p_fixed] = p_values
-            w[2 * i] = starts[k]
-            w[2 * i + 1] = starts[k + 1] - starts[k]
-            maps.append((proxy, actual))
+            k = bisect.bisect_right(starts, float(y[where])) - 1  # -1 and n_el: past the wire's ends
+            k = min(max(k, -1), len(starts) - 1)
+            m = self._element(i, k)
+            for target, source, (to_set, values, to_add, sources, weights) in zip(
+                    (y_rest, p_rest, p_rest, p_rest), (y, p, p, p), m.fills):
+                target[to_set] = values
+                np.add.at(target, to_add, weights * source[sources])
+            w[2 * i], w[2 * i + 1] = m.start, m.length
+            maps.append(m)
         return y_rest, p_rest, w, maps
 
-    def _element(self, i: int, k: int):
-        """Where the values of element ``k`` go in item ``i``'s proxy places of the rest's
-        inputs: ``(proxy, actual, y_parts, p_parts)``, each part ``(to, from, fixed_to,
-        fixed_values)`` (a fixed coordinate enters with its value and zero rates). Cached: a
-        contact stays on an element for many evaluations."""
+    def _element(self, i: int, k: int) -> "ElementMap":
+        """The :class:`ElementMap` of element ``k`` of item ``i``'s wire (-1 and ``n_el``: the
+        straight continuations past its start and end). Cached: a contact stays on an element
+        for many evaluations."""
         cache = self._elements.setdefault(i, {})
         found = cache.get(k)
         if found is None:
-            n_u = self.n_u
-            _, j, index, fixed, _ = self.items[i]
+            from ..assembly.windows import extension_length, extension_rows
+
+            sl, j, index, _, _ = self.items[i]
+            n_el, n_loc = len(sl.element_start) - 1, sl.element_indices.shape[1]
+            starts = sl.element_start
+            if 0 <= k < n_el:
+                rows, cols, weights = np.arange(n_loc), sl.element_indices[k], np.ones(n_loc)
+                start, length = starts[k], starts[k + 1] - starts[k]
+            else:
+                end = k == n_el
+                edge = n_el - 1 if end else 0
+                length = extension_length(starts)
+                rows, cols, weights = extension_rows(sl.element_indices[edge], sl.wire.element.dim, end, length)
+                start = starts[n_el] if end else starts[0] - length
+            sources = self._y_of_q[cols]
+            free = sources >= 0
+            constant = np.zeros(n_loc)
+            np.add.at(constant, rows[~free], weights[~free] * self._q_fixed[cols[~free]])
+            rows, sources, weights = rows[free], sources[free], weights[free]
+            # (to set, their values, to add to, sources, weights) for y and the three blocks of p
+            fills = []
             y_at, p_at = self._places[i]
-            proxy, actual = index[j], index[k]
-            free = actual >= 0
-
-            def parts(places, offset, values):
-                on, off = (places >= 0) & free, (places >= 0) & ~free
-                return places[on], actual[on] + offset, places[off], values[off]
-
-            y_parts = parts(y_at, 0, fixed[k])
-            p_blocks = [parts(places, block * n_u, fixed[k] if block == 0 else np.zeros(fixed[k].shape))
-                        for block, places in enumerate(p_at)]
-            p_parts = tuple(np.concatenate([b[m] for b in p_blocks]) for m in range(4))
-            found = cache[k] = (proxy, actual, y_parts, p_parts)
+            for block, places in enumerate([y_at, *p_at]):
+                on, add = places >= 0, places[rows] >= 0
+                offset = 0 if block == 0 else (block - 1) * self.n_u
+                fills.append((places[on], constant[on] if block <= 1 else np.zeros(int(on.sum())), places[rows[add]],
+                              sources[add] + offset, weights[add]))
+            found = cache[k] = ElementMap(index[j], rows, sources, weights, fills, float(start), float(length))
         return found
 
 
+class ElementMap:
+    """How a proxy element's coordinates are made of the actual element's (y indices):
+    proxy coordinate ``rows[t]`` gets ``weights[t] * y[sources[t]]`` summed over the terms ``t``,
+    plus the fixed coordinates' values; ``proxy`` are the proxy's own y indices, ``fills`` the
+    writes into the rest's inputs (y, then the three blocks of p), ``start``/``length`` the
+    actual element's (m). For a real element the map is a one-to-one copy; for a wire's straight continuation the
+    far node's position also takes the end gradient times the element length."""
+
+    def __init__(self, proxy, rows, sources, weights, fills, start, length):
+        self.proxy, self.fills, self.start, self.length = proxy, fills, start, length
+        # per proxy coordinate, its terms (sorted): for expanding Jacobian entries
+        order = np.argsort(rows, kind="stable")
+        self.rows, self.sources, self.weights = rows[order], sources[order], weights[order]
+        self._count = np.bincount(self.rows, minlength=proxy.size)
+        self._first = np.cumsum(self._count) - self._count
+
+    def terms(self, local: np.ndarray):
+        """The terms of proxy coordinates ``local`` (positions in :attr:`proxy`): ``(position in
+        local, actual y index, weight)`` per term (a coordinate with only fixed terms has none)."""
+        counts = self._count[local]
+        position = np.repeat(np.arange(local.size), counts)
+        within = np.arange(position.size) - np.repeat(np.cumsum(counts) - counts, counts)
+        term = self._first[local[position]] + within
+        return position, self.sources[term], self.weights[term]
+
+
 def move_back(vector: np.ndarray, maps) -> None:
-    """Add the proxies' entries of ``vector`` to their actual elements' (in place)."""
-    values = [vector[proxy].copy() for proxy, _ in maps]
-    for proxy, _ in maps:
-        vector[proxy] = 0.0
-    for (_, actual), v in zip(maps, values):
-        keep = actual >= 0
-        np.add.at(vector, actual[keep], v[keep])
+    """Add the proxies' entries of ``vector`` to their actual elements' (in place): the
+    transpose of each :class:`ElementMap`."""
+    values = [vector[m.proxy].copy() for m in maps]
+    for m in maps:
+        vector[m.proxy] = 0.0
+    for m, v in zip(maps, values):
+        np.add.at(vector, m.sources, m.weights * v[m.rows])

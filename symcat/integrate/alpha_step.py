@@ -245,13 +245,12 @@ class StepEquations:
         values = self._rest_jacobian.nonzeros(y_rest, p_in, w, mode)[0]
         keep = values != 0
         rows, cols, data = self._jac_rows[keep], self._jac_cols[keep], values[keep]
-        if maps is not None:  # the proxies' rows and columns are those of the actual elements
-            to = np.arange(self.n_y)
-            for proxy, actual in maps:
-                to[proxy] = actual
-            rows, cols = to[rows], to[cols]
-            keep = (rows >= 0) & (cols >= 0)
-            rows, cols, data = rows[keep], cols[keep], data[keep]
+        if maps is not None:  # the proxies' rows and columns are made of the actual elements'
+            # J_actual = T^T J_proxy T, T the maps of the proxy coordinates
+            at, rows, weight = self.proxies.expand(maps, rows)
+            cols, data = cols[at], data[at] * weight
+            at, cols, weight = self.proxies.expand(maps, cols)
+            rows, data = rows[at], data[at] * weight
         n_b, n_u, n_c = self.bulk.n_b, self.n_u, self.n_c
         if self.variant == "stabilized" and n_b:
             g = (rows >= n_u) & (rows < n_u + n_c) & (cols < n_b)  # G on the bulk coordinates

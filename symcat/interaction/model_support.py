@@ -108,8 +108,8 @@ PANTOGRAPH_CHOICES = ("lumped", "lumped_scene", "seo2005")
 PANTOGRAPH_PARAMETER = Parameter(
     "pantograph", "lumped", "", "pantograph model: lumped (the model's lumped-mass pantograph on the interaction "
     "path), lumped_scene (the same pantograph as scene bodies on the shared multibody path) or seo2005 (the seed "
-    "paper's four-body pantograph as scene bodies); on the multibody path one tension section (and two pantographs "
-    "for lumped_scene with penalty contact only), the uplift trimmed to the static contact force",
+    "paper's four-body pantograph as scene bodies); on the multibody path overlaps and two pantographs (lumped_scene) "
+    "with penalty contact only, the uplift trimmed to the static contact force",
     choices=PANTOGRAPH_CHOICES)
 
 
@@ -136,9 +136,9 @@ def check_scene_pantograph(p: dict, stagger: float, n_pantographs: int = 1, tens
         raise ParameterError(f"n_pantographs={n_pantographs} with {name} and contact={p['contact']}: this multibody "
                              "pantograph runs alone (n_pantographs=1); two pantographs need pantograph=lumped, or "
                              "pantograph=lumped_scene with contact=penalty")
-    if tension_sections != 1:
-        raise ParameterError(f"tension_sections={tension_sections} with {name}: the multibody passage runs on one "
-                             "tension section (tension_sections=1); overlaps need pantograph=lumped")
+    if tension_sections != 1 and p["contact"] == "bilateral":
+        raise ParameterError(f"tension_sections={tension_sections} with {name} and contact=bilateral: a sliding joint "
+                             "cannot pass an overlap; allowed: contact=penalty, or tension_sections=1")
     if p["contact"] == "bilateral" and stagger != 0:
         raise ParameterError(f"contact=bilateral with {name}: the contact wire is staggered (+/-{abs(stagger):g} m) "
                              "and the sliding joint would pull it onto the pantograph's plane; allowed: "

@@ -113,14 +113,57 @@ def contact_element(scene, name: str):
                          "the scene; it must return the name of its pan-head/wire contact")
 
 
+#: Separates a pan-head's contact name from the contact wire of its copies on the other
+#: tension sections' wires (:func:`add_section_contacts`).
+SECTION_MARK = "@"
+
+
 def static_force(eq, element) -> float:
     """Static contact force (N, pressing the pan-head down) of the contact ``element`` in the
-    equilibrium ``eq``: the penalty force, or minus the sliding joint's vertical reaction."""
+    equilibrium ``eq``: the penalty force (with its copies on other sections' wires), or minus
+    the sliding joint's vertical reaction."""
     from ..scene import PenaltyContact
 
     if isinstance(element, PenaltyContact):
-        return float(eq.contact_force_N[element.name])
+        return float(sum(f for name, f in eq.contact_force_N.items()
+                         if name == element.name or name.startswith(element.name + SECTION_MARK)))
     return -float(eq.reactions_N[element.name][2])
+
+
+def running_contact_wire(form: FormFindingResult, x: float) -> str:
+    """Scene name of the contact wire in running at ``x`` (m): the lowest one there in the
+    static catenary (the one a pan-head at ``x`` touches)."""
+    from .contact import contact_wire_locators, running_wire
+
+    st = form.structure
+    return st.contacts[running_wire(st, contact_wire_locators(st), np.asarray(form.q, float), x)].name
+
+
+def add_section_contacts(form: FormFindingResult, scene, element, x0: float) -> list:
+    """Copies of the pan-head's penalty contact ``element`` on the contact wires of the other
+    tension sections (named ``<element>@<wire>``), so that the pan-head runs through overlaps:
+    each copy acts where its wire comes down to the pan-head and, off its wire, follows the
+    wire's straight continuation past its anchor, far above (see
+    :meth:`~symcat.assembly.windows.ElementWindows._selection`). Their first arc lengths are
+    ``x0`` (m) projected on each wire. Returns the copies."""
+    from dataclasses import replace
+
+    from ..pantograph.lumped_scene import wire_height
+
+    copies = []
+    for body in form.structure.contacts:
+        if body.name == element.wire:
+            continue
+        wire = scene.find(body.name)
+        xs = np.asarray(wire.q0, float)[:, wire.coordinate_index("x")]
+        length = float(np.sum(wire.params[:, 0]))
+        if xs[0] <= x0 <= xs[-1]:
+            s0 = wire_height(scene, body.name, x0)[1]
+        else:  # on the continuation past an anchor (about along x there)
+            s0 = x0 - xs[0] if x0 < xs[0] else length + x0 - xs[-1]
+        copies.append(scene.add(replace(element, name=f"{element.name}{SECTION_MARK}{body.name}", wire=body.name,
+                                        s0=float(s0))))
+    return copies
 
 
 def _static(form, pantographs, wire: str, positions, speed: float, uplifts, wires: str = "nonlinear"):
@@ -130,9 +173,21 @@ def _static(form, pantographs, wire: str, positions, speed: float, uplifts, wire
     from ..assembly.multibody import MultibodyModel
     from ..catenary.scene import catenary_scene
 
+    from ..scene import PenaltyContact
+
     scene = catenary_scene(form, wires=wires)
-    elements = [contact_element(scene, panto.add(scene, wire, x0, speed, float(u)))
-                for panto, x0, u in zip(pantographs, positions, uplifts)]
+    sections = len(form.structure.contacts) > 1
+    elements = []
+    for panto, x0, u in zip(pantographs, positions, uplifts):
+        running = running_contact_wire(form, x0) if sections else wire
+        element = contact_element(scene, panto.add(scene, running, x0, speed, float(u)))
+        if sections:
+            if not isinstance(element, PenaltyContact):
+                raise ParameterError(f"pantograph {panto.name}: a sliding joint (bilateral contact) cannot pass the "
+                                     f"overlaps of {len(form.structure.contacts)} tension sections; allowed: a "
+                                     "penalty contact (contact=penalty)")
+            add_section_contacts(form, scene, element, x0)
+        elements.append(element)
     model = MultibodyModel(scene)
     eq = solve_equilibrium(model)
     return scene, model, elements, eq

@@ -57,8 +57,10 @@ static contact force of a pantograph pressing on the wire is affine in its uplif
 paper's four-body pantograph plugs in through the same mechanism (:func:`seo2005_fragment`).
 
 Several pantographs: pass a list of fragments with distinct element names (penalty contacts),
-``spacing`` apart, leading first (:func:`lumped_fragment` takes a ``name``). Limits: one tension
-section (no overlaps). Not recorded on this path (a :class:`SceneRecord` lists them in
+``spacing`` apart, leading first (:func:`lumped_fragment` takes a ``name``). On a line of several
+tension sections each pan-head starts under the wire in running, and its penalty contact is
+copied onto the other sections' contact wires (:func:`~.scene_pantographs.add_section_contacts`),
+which hand it over in the overlaps. Not recorded on this path (a :class:`SceneRecord` lists them in
 ``not_computed``): the energy balance of the passage and the Newton iterations per step.
 """
 from __future__ import annotations
@@ -76,6 +78,7 @@ from ..errors import ParameterError
 from ..progress import notice
 from .passage import pantograph_statistics, passage_plan
 from .scene_pantographs import (
+    SECTION_MARK,
     PantographFragment,
     ScenePantograph,
     lumped_fragment,
@@ -231,16 +234,27 @@ class ScenePassageResult:
 def _monitor(form, model, elements):
     """Per-step records of the penalty contacts' passage (generalized-alpha's ``monitor``):
     what the statistics need at every step, without a full output per step (one column per
-    pantograph)."""
+    pantograph; the force on each tension section's contact wire in ``contact_force_wire_N``,
+    a pan-head's force their sum and its penetration the largest)."""
     st = form.structure
     heads = np.array([model.rigid_offset[e.body] for e in elements])
     names = [ct.joint.name for ct in model.contacts]
-    k = np.array([names.index(e.name) for e in elements])
+    wires = [b.name for b in st.contacts]
+    # (pantograph, wire) -> contact index: the pan-head's contact on its running wire or a copy
+    index = np.full((len(elements), len(wires)), -1)
+    for p, e in enumerate(elements):
+        for k, name in enumerate(names):
+            if name == e.name or name.startswith(e.name + SECTION_MARK):
+                index[p, wires.index(model.contacts[k].joint.wire)] = k
+    has = index >= 0
+    at = np.where(has, index, 0)
     supports = st.cw_xyz[st.support_nodes, 2]
 
     def monitor(s):
-        return {"x_contact_m": s.q[heads], "contact_force_N": s.force_N[k], "penetration_m": -s.gap_m[k],
-                "panhead_z_m": s.q[heads + 2], "panhead_acc_m_s2": s.a[heads + 2], "support_z_m": s.q[supports],
+        force = np.where(has, s.force_N[at], 0.0)
+        return {"x_contact_m": s.q[heads], "contact_force_N": force.sum(axis=1), "contact_force_wire_N": force,
+                "penetration_m": np.where(has, -s.gap_m[at], -np.inf).max(axis=1), "panhead_z_m": s.q[heads + 2],
+                "panhead_acc_m_s2": s.a[heads + 2], "support_z_m": s.q[supports],
                 "dropper_tension_N": st.dropper_state(s.q[: st.n])[2]}
 
     return monitor
@@ -258,7 +272,7 @@ def record_histories(res, form, model, element, snapshot_every: float) -> dict:
         snap = _snapshots(np.asarray(res.t_s), snapshot_every)
         return {"t_s": m["t_s"], **{key: m[key] for key in ("x_contact_m", "contact_force_N", "penetration_m",
                                                              "panhead_z_m", "panhead_acc_m_s2")},
-                "contact_force_wire_N": m["contact_force_N"][:, :, None], "support_z_m": m["support_z_m"],
+                "contact_force_wire_N": m["contact_force_wire_N"], "support_z_m": m["support_z_m"],
                 "dropper_tension_N": m["dropper_tension_N"], "snapshot_t_s": np.asarray(res.t_s)[snap],
                 "snapshot_q": q[snap, : st.n]}
     head = model.rigid_offset[element.body]
@@ -307,7 +321,7 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
     Parameters
     ----------
     design : CatenaryDesign
-        One tension section.
+        One or several tension sections (penalty contacts for several).
     pantograph : ScenePantograph
         The fragment (module docstring) and a first guess of its uplift.
     speed : float
@@ -349,8 +363,6 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
     from ..integrate import generalized_alpha
 
     t0 = time.perf_counter()
-    if design.n_sections != 1:
-        raise ParameterError(f"tension_sections={design.n_sections}: a scene passage runs on one tension section (1)")
     if not speed > 0:
         raise ParameterError(f"speed={speed:g} m/s: must be > 0")
     if not target_force > 0:

@@ -75,3 +75,47 @@ def test_bad_contact_parameters_are_named():
     scene.add(RigidBody("b", 1.0, (1, 1, 1)))
     with pytest.raises(ParameterError, match="contact 'c': wire='a' is not an ANCF body"):
         scene.add(PenaltyContact("c", "a", "b", s0=0.0))
+
+
+@pytest.mark.parametrize("x_head", [5.5, -1.5])
+def test_a_contact_past_the_wire_end_is_on_its_straight_continuation(x_head):
+    """Past a wire's end a contact point follows the wire's straight continuation along the end
+    tangent (the tangency stays solvable for a pan-head that has left a tension section's
+    wire) and exerts no force: on a straight inclined wire the closest point and the normal gap
+    are those of the line, beyond either end (the gap positive below the line, where a pan-head
+    is clear of its wire), and the force is zero even when the point is 30 cm into the line."""
+    import casadi as ca
+
+    from symcat.dae.formulation import Formulation
+    from symcat.dae.initial import locate_contacts
+
+    slope = 0.1
+    sec = Section.from_stiffness(1e6, 1.0, 1e11)
+    wire = AncfBody.straight("wire", "cable3d", [0, 0, 0], [4, 0, 4 * slope], 4, Material(1e11, 0.5 / sec.A), sec)
+    wire.pin(0).pin(-1)
+    scene = Scene(gravity=(0, 0, -G))
+    scene.add(wire)
+    t = np.array([1.0, 0.0, slope]) / np.hypot(1.0, slope)
+    for dz in (0.3, -0.02):  # into the line (above it), and 2 cm clear below it
+        scene = Scene(gravity=(0, 0, -G))
+        scene.add(wire)
+        point = np.array([x_head, 0.0, slope * x_head + dz])
+        scene.add(RigidBody("head", MASS, (0.01, 0.01, 0.01), tuple(point)))
+        scene.add(PenaltyContact("contact", "wire", "head", s0=float(point @ t) + 0.3, stiffness=5e4))
+        model = MultibodyModel(scene)
+        form = Formulation(model)
+        q, v, s, w, ts = (ca.MX.sym(n, k) for n, k in (("q", form.n_f), ("v", form.n_f), ("s", 0), ("w", 0), ("t", 1)))
+        sc = ca.MX.sym("sc", 1)
+        k = form.terms(q, v, s, w, ts, sc)
+        names = ["C", "Cq", "Cs", "Ct", "Qd", "M", "Q", "T"]
+        no_contacts = form.terms(q, v, s, w, ts, sc, contacts=False)["Q"]
+        outs = [k[n] for n in names] + [ca.diag(ca.jacobian(k["T"], sc)), k["gap"], k["fc"], k["Q"] - no_contacts]
+        fn = ca.Function("terms", [q, v, s, w, ts, sc], outs)
+        q0 = form.to_internal(model.q0[model.free])
+        sc0 = locate_contacts(fn, q0, np.zeros(form.n_f), [], [], 0.0, [float(point @ t) + 0.3])
+        gap, force, generalized = (np.asarray(x).ravel() for x in fn(q0, np.zeros(form.n_f), [], [], 0.0, sc0)[9:])
+        assert sc0[0] == pytest.approx(point @ t, abs=1e-9)  # the foot of the normal on the line
+        assert not 0 <= sc0[0] <= 4 * np.hypot(1.0, slope)  # off the wire
+        assert gap[0] == pytest.approx(-dz / np.hypot(1.0, slope), abs=1e-9)  # distance to the line
+        assert force[0] == 0.0
+        assert np.abs(generalized).max() == 0.0  # no force on the wire nor on the head

@@ -137,7 +137,8 @@ def test_a_users_own_pantograph_fragment():
 
 @pytest.mark.parametrize("sets, words", [
     (["pantograph=seo2005", "n_pantographs=2"], ["n_pantographs=2", "pantograph=seo2005", "n_pantographs=1"]),
-    (["pantograph=seo2005", "tension_sections=2"], ["tension_sections=2", "pantograph=seo2005", "tension_sections=1"]),
+    (["pantograph=seo2005", "tension_sections=2", "contact=bilateral"],
+     ["tension_sections=2", "pantograph=seo2005", "contact=bilateral", "contact=penalty"]),
     (["pantograph=seo2005", "contact=bilateral"], ["contact=bilateral", "pantograph=seo2005", "contact=penalty"]),
     (["pantograph=seo2005", "pantograph_damping_N_s_m=1,2,3"], ["pantograph_damping_N_s_m=1,2,3", "pantograph=lumped"]),
     (["pantograph=lumped_scene", "n_pantographs=2", "contact=bilateral"],
