@@ -6,7 +6,8 @@ multipliers) solve the KKT system at ``v = 0``::
 
     R(u) = [Q(q, s_c) - C_q^T lambda,  -C_s^T lambda,  C(q, s, t),  T(q, s_c)] = 0
 
-with the Jacobian ``J`` from CasADi (compiled kernel companions).
+whose iteration matrices are those of a generalized-alpha step from rest (:class:`_StepSystem`):
+the wires' banded Cholesky and the rest's Woodbury update, shared with the time integration.
 
 Plain Newton stalls here: a frictionless sliding point on a straight wire has no stiffness
 along the wire until the wire sags (a singular Jacobian at the start, and a load continuation
@@ -30,11 +31,8 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
-import scipy.sparse as sps
-import scipy.sparse.linalg as spla
 
 from ..assembly.multibody import MultibodyModel
-from ..codegen.library import BufferedFunction
 from ..dae.formulation import Formulation
 from ..errors import SolverError
 from ..integrate.results import joint_reactions
@@ -92,28 +90,76 @@ class EquilibriumResult:
                 "constraint_residual_m": self.constraint_residual, "wall_s": self.wall_s}
 
 
-class _Kkt:
-    """The residual ``R(u)``, its sparse Jacobian and the mass matrix as one CasADi function."""
+class _StepSystem:
+    """The static residual ``R(u)`` and the pseudo-transient solve ``(J - M / h^2) du = rhs`` on
+    generalized-alpha's step equations (:class:`~symcat.integrate.alpha_step.StepEquations`,
+    index-3 form): a step from rest (``v_pred = 0``, ``b = 0``, ``gamma h = 0``, ``c_m = 1``,
+    ``beta h^2 = h^2``) from the current point has the residual ``M du - h^2 R`` on the force
+    rows and the Jacobian ``-h^2 (J - M / h^2)`` there (the constraint and tangency rows as they
+    are, the multipliers scaled by ``h^2``). So the statics shares the step's linear algebra
+    (the wires' banded Cholesky, the rest's Woodbury update, its compiled or expanded rest, the
+    proxy elements of moving contacts) instead of differentiating the whole model once more:
+    on a line, a fraction of a second to build and milliseconds per iteration."""
 
     def __init__(self, model: MultibodyModel, t: float):
+        from ..integrate.alpha_step import StepEquations
+
         form = Formulation(model, "augmented", "1")
-        self.form = form
+        self.form, self.t = form, float(t)
         n_f, n_s, n_sc, n_c = form.n_f, form.n_s, form.n_sc, form.n_c
         self.sizes = (n_f, n_s, n_sc, n_c)
-        u = ca.MX.sym("u", n_f + n_s + n_sc + n_c)
-        q, s = u[:n_f], u[n_f : n_f + n_s]
-        sc, lam = u[n_f + n_s : n_f + n_s + n_sc], u[n_f + n_s + n_sc :]
-        k = form.terms(q, ca.MX.zeros(n_f), s, ca.MX.zeros(n_s), ca.MX(t), sc)
-        r = ca.vertcat(k["Q"] - ca.mtimes(k["Cq"].T, lam), -ca.mtimes(k["Cs"].T, lam), k["C"], k["T"])
-        self.fn = ca.Function("kkt", [u], [ca.densify(r), ca.jacobian(r, u), k["M"]])
-        self._buffered = BufferedFunction(self.fn)
-        self.extras = ca.Function("extras", [u], [k["Cq"], k["gap"], k["fc"]])
         self.n_force = n_f + n_s
+        self.step = StepEquations(form, "index3", compiled=None)
         self.windows = [sl.window for sl in model.windowed()]
+        self._extras = None
 
-    def __call__(self, u):
-        r, j, m = self._buffered.sparse(u)
-        return r.toarray().ravel(), j, m
+    def _step_point(self, u: np.ndarray, bh2: float, cm: float = 1.0):
+        """Step unknowns ``y`` and data ``p`` of a step from rest from the point ``u``."""
+        n_f, n_s, n_sc, n_c = self.sizes
+        n_u = n_f + n_s
+        y = np.empty(n_u + n_c + n_sc)
+        y[:n_u] = u[:n_u]
+        y[n_u : n_u + n_c] = bh2 * u[n_u + n_sc :]
+        y[n_u + n_c :] = u[n_u : n_u + n_sc]
+        p = np.concatenate([u[:n_u], np.zeros(2 * n_u), [self.t, bh2, 0.0, cm]])
+        return y, p
+
+    def residual(self, u: np.ndarray) -> np.ndarray:
+        """``R(u) = [Q - C_q^T lambda, -C_s^T lambda, C, T]`` (N, m): the step's rows, whose
+        order it shares, at ``du = 0`` with ``h = 1``."""
+        n_u = self.n_force
+        g = self.step.residual(*self._step_point(u, 1.0))
+        g[:n_u] *= -1.0
+        return g
+
+    def solve(self, u: np.ndarray, h: float, rhs: np.ndarray) -> np.ndarray:
+        """``du`` with ``(J(u) - M / h^2) du = rhs`` (``J = dR/du``; ``M`` on the coordinates)."""
+        n_f, n_s, n_sc, n_c = self.sizes
+        n_u = n_f + n_s
+        bh2 = h * h
+        y, p = self._step_point(u, bh2)
+        self.step.factorize(y, p)
+        # rows: -h^2 on the force rows, 1 on C and T; the step's order [forces, C, T]
+        r = np.concatenate([-bh2 * rhs[:n_u], rhs[n_u : n_u + n_c], rhs[n_u + n_c :]])
+        dy = self.step.solve(r)
+        return np.concatenate([dy[:n_u], dy[n_u + n_c :], dy[n_u : n_u + n_c] / bh2])
+
+    def stiffness_diagonal(self, u: np.ndarray) -> np.ndarray:
+        """``|diag dR/dq|`` on the coordinates (N/m): the round-off floor of the force residual."""
+        y, p = self._step_point(u, 1.0, cm=0.0)
+        return np.abs(self.step.jacobian(y, p).diagonal()[: self.sizes[0]])
+
+    def extras(self, u: np.ndarray):
+        """``C_q`` (dense, free columns), contact gaps (m) and normal forces (N) at ``u``."""
+        n_f, n_s, n_sc, n_c = self.sizes
+        if self._extras is None:
+            q, s, sc = ca.MX.sym("q", n_f), ca.MX.sym("s", n_s), ca.MX.sym("sc", n_sc)
+            k = self.form.terms(q, ca.MX.zeros(n_f), s, ca.MX.zeros(n_s), ca.MX(self.t), sc)
+            self._extras = ca.Function("extras", [q, s, sc], [k["Cq"]])
+        n_u = n_f + n_s
+        cq = np.asarray(ca.densify(self._extras(u[:n_f], u[n_f:n_u], u[n_u : n_u + n_sc])))
+        gap, force = self.step.contacts(u[:n_u], np.zeros(n_u), u[n_u : n_u + n_sc], self.t)
+        return cq, gap, force
 
 
 def solve_equilibrium(model: MultibodyModel, t: float = 0.0, rtol: float = 1e-9, max_iterations: int = 200,
@@ -147,39 +193,40 @@ def solve_equilibrium(model: MultibodyModel, t: float = 0.0, rtol: float = 1e-9,
     saved = [sl.window for sl in model.windowed()]
     try:
         model.center_windows()
-        kkt = _Kkt(model, t)
-        return _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, pseudo_time_step, t0, t)
+        system = _StepSystem(model, t)
+        return _relaxation(model, system, rtol, max_iterations, max_pseudo_time, pseudo_time_step, t0, t)
     finally:
         for sl, w in zip(model.windowed(), saved):
             sl.window = w
 
 
-def _moved_windows(model, kkt, u, t):
-    """The KKT system of windows centred on the arc lengths of ``u`` when a point nears its
-    window's edge (a window over the whole wire would make the contact's Jacobian block dense
-    over every element: minutes on a line of a few thousand coordinates), else ``kkt``."""
-    n_f, n_s, n_sc, _ = kkt.sizes
-    if not model.windowed():
-        return kkt
+def _moved_windows(model, system, u, t):
+    """The step system of windows centred on the arc lengths of ``u`` when a point nears its
+    window's edge (a window over the whole line would make the contact's Jacobian block dense
+    over every element), else ``system``: only when the step has no proxy elements (with them
+    the windows never need to move)."""
+    n_f, n_s, n_sc, _ = system.sizes
+    if not model.windowed() or system.step.proxies is not None:
+        return system
     s = np.r_[u[n_f : n_f + model.n_sliding], u[n_f + n_s : n_f + n_s + n_sc]]
     if model.window_margin(s) >= 2:
-        return kkt
+        return system
     for sl, s_k in zip(model.windowed(), s):
         model.set_window(sl, float(s_k))
-    return _Kkt(model, t)
+    return _StepSystem(model, t)
 
 
-def _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, h0, t0, t):
-    form = kkt.form
-    n_f, n_s, n_sc, n_c = kkt.sizes
+def _relaxation(model, system, rtol, max_iterations, max_pseudo_time, h0, t0, t):
+    form = system.form
+    n_f, n_s, n_sc, n_c = system.sizes
     u = np.r_[form.to_internal(model.q0[model.free]), model.s0, model.sc0, np.zeros(n_c)]
-    r, j, mass = kkt(u)
-    nf = kkt.n_force
+    r = system.residual(u)
+    nf = system.n_force
     force_tol = rtol * max(np.abs(r[:nf]).max(initial=0.0), 1.0)
     geo_tol = rtol * (1.0 + np.abs(model.q0).max(initial=0.0))
     # Round-off floor of the force residual: stiff wires (EA ~ 1e9 N) cannot get below ~1e-15 EA/L.
-    force_tol = max(force_tol, 1e-15 * np.abs(j.diagonal()[:n_f]).max(initial=0.0) * (1.0 + np.abs(model.q0).max(initial=0.0)))
-    pad = sps.csc_matrix((len(u) - n_f, len(u) - n_f))
+    force_tol = max(force_tol, 1e-15 * system.stiffness_diagonal(u).max(initial=0.0)
+                    * (1.0 + np.abs(model.q0).max(initial=0.0)))
     limits = _arc_limits(model)
     h, history = h0, []
     f_norm = np.abs(r[:nf]).max(initial=0.0)
@@ -187,26 +234,28 @@ def _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, h0, t0, t):
         g_norm = np.abs(r[nf:]).max(initial=0.0)
         if f_norm <= force_tol and g_norm <= geo_tol:
             break
-        inertia = sps.block_diag([mass / h**2, pad])
-        with np.errstate(all="ignore"):
-            du = spla.spsolve((j - inertia).tocsc(), -r)
+        try:
+            with np.errstate(all="ignore"):
+                du = system.solve(u, h, -r)
+        except SolverError:
+            du = np.full_like(u, np.nan)
         if not np.all(np.isfinite(du)):
             h /= 4
             continue
         arc = du[n_f : n_f + n_s + n_sc]
         if arc.size and np.any(np.abs(arc) > limits):
             du *= np.min(limits / np.maximum(np.abs(arc), 1e-300))
-        r_new, j_new, mass_new = kkt(u + du)
+        r_new = system.residual(u + du)
         f_new = np.abs(r_new[:nf]).max(initial=0.0)
         if not np.isfinite(f_new) or f_new > 1e3 * max(f_norm, force_tol):
             h /= 4  # rejected: more pseudo-inertia
             history.append((it, h, f_norm, False))
             continue
-        u, r, j, mass = u + du, r_new, j_new, mass_new
-        moved = _moved_windows(model, kkt, u, t)
-        if moved is not kkt:
-            kkt = moved
-            r, j, mass = kkt(u)
+        u, r = u + du, r_new
+        moved = _moved_windows(model, system, u, t)
+        if moved is not system:
+            system = moved
+            r = system.residual(u)
         # The pseudo time step doubles while the force residual falls, up to max_pseudo_time,
         # where the iteration is Newton's method with a negligible M / h^2 that keeps neutral
         # directions (a free spin) regular.
@@ -215,18 +264,18 @@ def _relaxation(model, kkt, rtol, max_iterations, max_pseudo_time, h0, t0, t):
         f_norm = f_new
         history.append((it, h, f_norm, True))
     else:
-        raise SolverError(_failure_message(model, kkt, u, max_iterations))
+        raise SolverError(_failure_message(model, system, u, max_iterations))
     q = model.q0.copy()
     q[model.free] = form.to_physical(u[:n_f])
     lam = u[n_f + n_s + n_sc :].copy()
-    cq, gap, fc = (np.asarray(ca.densify(x)) for x in kkt.extras(u))
+    cq, gap, fc = system.extras(u)
     names = [ct.joint.name for ct in model.contacts]
     return EquilibriumResult(
         q=q, s_m=u[n_f : n_f + n_s].copy(), sc_m=u[n_f + n_s : n_f + n_s + n_sc].copy(),
         multipliers=lam, residual_N=float(f_norm),
         constraint_residual=float(np.abs(r[nf:]).max(initial=0.0)), iterations=len(history),
         wall_s=time.perf_counter() - t0, history=history, reactions_N=joint_reactions(model, cq, lam),
-        contact_gap_m=dict(zip(names, gap.ravel().tolist())), contact_force_N=dict(zip(names, fc.ravel().tolist())))
+        contact_gap_m=dict(zip(names, np.ravel(gap).tolist())), contact_force_N=dict(zip(names, np.ravel(fc).tolist())))
 
 
 def _arc_limits(model) -> np.ndarray:
@@ -234,9 +283,9 @@ def _arc_limits(model) -> np.ndarray:
     return np.array([0.25 * np.diff(sl.element_start).min() for sl in model.windowed()])
 
 
-def _failure_message(model, kkt, u, iterations) -> str:
-    r = np.abs(kkt(u)[0])
-    n_f, n_s, n_sc, n_c = kkt.sizes
+def _failure_message(model, system, u, iterations) -> str:
+    r = np.abs(system.residual(u))
+    n_f, n_s, n_sc, n_c = system.sizes
     coords = [model.coordinate_names()[i] for i in model.free]
     names = ([f"force on {c}" for c in coords] + [f"C_s^T lambda of {sl.joint.name}" for sl in model.sliding]
              + [f"constraint {n}" for n in model.row_names] + [f"tangency of contact {ct.joint.name}" for ct in model.contacts])
