@@ -75,7 +75,7 @@ def test_dropper_tensions_converge_with_the_mesh(form):
 
 def test_support_reactions_carry_the_weight(form):
     """Messenger support preloads plus end reactions equal the total weight (global balance)."""
-    st, d = form.structure, form.structure.design
+    st = form.structure
     q = form.q
     f = st.forces(q)
     fixed = np.setdiff1d(np.arange(st.n), st.free)

@@ -7,7 +7,6 @@ import pytest
 from symcat.assembly.multibody import MultibodyModel
 from symcat.errors import ParameterError, SolverError
 from symcat.integrate import simulate
-from symcat.model import run_model
 from symcat.scene import (AncfBody, Bushing, Driving, Fixed, Material, PointLoad, Prismatic, Revolute, RigidBody,
                           RotationalSpring, Scene, Section, SlidingJoint, Spherical, SpringDamper)
 

@@ -2,7 +2,6 @@
 energy conservation, drift, and the four DAE forms."""
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from symcat.model import run_model

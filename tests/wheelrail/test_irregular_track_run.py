@@ -3,8 +3,6 @@ vehicle models, :func:`symcat.wheelrail.track.read_irregularities`): a wheelset 
 alignment bump against the kinematic equations, the vehicle on a layout, bad files."""
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
