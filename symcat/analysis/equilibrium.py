@@ -102,14 +102,14 @@ class _StepSystem:
     on a line, a fraction of a second to build and milliseconds per iteration."""
 
     def __init__(self, model: MultibodyModel, t: float):
-        from ..integrate.alpha_step import StepEquations
+        from ..integrate.alpha_step import step_equations
 
         form = Formulation(model, "augmented", "1")
         self.form, self.t = form, float(t)
         n_f, n_s, n_sc, n_c = form.n_f, form.n_s, form.n_sc, form.n_c
         self.sizes = (n_f, n_s, n_sc, n_c)
         self.n_force = n_f + n_s
-        self.step = StepEquations(form, "index3", compiled=None)
+        self.step = step_equations(form, "index3", compiled=None)
         self.windows = [sl.window for sl in model.windowed()]
         self._extras = None
 

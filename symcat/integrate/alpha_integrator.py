@@ -14,7 +14,7 @@ import scipy.sparse.linalg as spla
 from ..dae.initial import consistent_state
 from ..errors import SolverError
 from .alpha_run import StepState
-from .alpha_step import StepEquations, solve_step
+from .alpha_step import StepEquations, solve_step, step_equations
 from .simulate import update_windows
 
 
@@ -62,7 +62,7 @@ class Integrator:
     def _build(self, previous: StepEquations | None = None) -> StepEquations:
         build = time.perf_counter()
         if previous is None:
-            stepper = StepEquations(self.form, self.variant, self.expand, compiled=self.compiled)
+            stepper = step_equations(self.form, self.variant, self.expand, compiled=self.compiled)
         else:  # a window moved: the bulk matrix does not depend on it
             stepper = StepEquations(self.form, self.variant, self.expand, previous.bulk, previous.mass_scale,
                                     compiled=self.compiled)
