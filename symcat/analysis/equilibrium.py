@@ -102,7 +102,7 @@ class _StepSystem:
     on a line, a fraction of a second to build and milliseconds per iteration."""
 
     def __init__(self, model: MultibodyModel, t: float):
-        from ..integrate.alpha_step import step_equations
+        from ..integrate.alpha_integrator import step_equations
 
         form = Formulation(model, "augmented", "1")
         self.form, self.t = form, float(t)

@@ -65,6 +65,17 @@ class System:
             k += es.stiffness(q)
         return k
 
+    def affine_forces(self):
+        """``(f0, K, q0)`` with the forces of :meth:`force_function` equal to ``f0 - K (q - q0)``
+        (``f0`` with the constant loads, ``K`` SciPy CSR) when they are affine in ``q`` and free
+        of velocities (``linear_wires``, no element damping, no slope moments), else None: a
+        caller may then evaluate them as one sparse product."""
+        if not self.scene.linear_wires or self._moments or any(es.damped for es in self.element_sets):
+            return None
+        f_ref, k_ref, q_ref = self._linearization
+        return (np.array(f_ref, float).ravel() + self._constant_load, to_scipy(k_ref).tocsr(),
+                np.array(q_ref, float).ravel())
+
     @cached_property
     def _linearization(self) -> tuple[ca.DM, ca.DM, ca.DM]:
         """Elastic forces and tangent stiffness at the initial coordinates, and those
@@ -183,17 +194,19 @@ class System:
     def strain_energy_expr(self, q: ca.MX) -> ca.MX:
         """Strain energy (J) at ``q``; with ``linear_wires`` the energy whose gradient is the
         linearized force, ``U(q0) - f(q0) dq + dq K(q0) dq / 2``."""
-        if self.scene.linear_wires:
-            f_ref, k_ref, q_ref = self._linearization
-            dq = q - q_ref
-            return self._reference_energy - ca.dot(f_ref, dq) + 0.5 * ca.dot(dq, ca.mtimes(k_ref, dq))
+        if not self.scene.linear_wires:
+            return self._elastic_energy(q)
+        f_ref, k_ref, q_ref = self._linearization
+        dq = q - q_ref
+        return self._reference_energy - ca.dot(f_ref, dq) + 0.5 * ca.dot(dq, ca.mtimes(k_ref, dq))
+
+    def _elastic_energy(self, q: ca.MX) -> ca.MX:
         return sum((es.energy(q) for es in self.element_sets), ca.MX(0))
 
     @cached_property
     def _reference_energy(self) -> float:
         q = ca.MX.sym("q", self.n)
-        u = sum((es.energy(q) for es in self.element_sets), ca.MX(0))
-        return float(ca.Function("energy", [q], [u])(self._linearization[2]))
+        return float(ca.Function("energy", [q], [self._elastic_energy(q)])(self._linearization[2]))
 
     @cached_property
     def _energy_function(self) -> ca.Function:

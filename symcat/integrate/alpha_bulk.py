@@ -168,14 +168,10 @@ class _BulkForces:
         self._q_fixed = np.array(form.q_fixed, float).ravel()
         q, v = ca.MX.sym("q", self._n_a), ca.MX.sym("v", self._n_a)
         system = model.ancf
-        self._linear = None
-        if system.scene.linear_wires and not any(es.damped for es in system.element_sets) and not system._moments:
-            # Linearized wires: ``f0 - K (q - q0)`` plus the constant loads, a SciPy product
-            # (CasADi's sparse product in its virtual machine took five times as long).
-            f_ref, k_ref, q_ref = system._linearization
-            self._linear = (np.array(f_ref, float).ravel() + system._constant_load, to_scipy(k_ref).tocsr(),
-                            np.array(q_ref, float).ravel())
-        else:
+        # Linearized wires: one SciPy product (CasADi's sparse product in its virtual machine
+        # took five times as long).
+        self._linear = system.affine_forces()
+        if self._linear is None:
             self._ancf = BufferedFunction(_expanded(ca.Function("alpha_bulk_ancf", [q, v], [ca.densify(
                 system.force_function()(q, v))]), expand))
         self._groups = []
