@@ -189,12 +189,15 @@ def solve_equilibrium(model: MultibodyModel, t: float = 0.0, rtol: float = 1e-9,
     SolverError
         Naming the largest residual row.
     """
+    from ..threads import serial_blas
+
     t0 = time.perf_counter()
     saved = [sl.window for sl in model.windowed()]
     try:
         model.center_windows()
         system = _StepSystem(model, t)
-        return _relaxation(model, system, rtol, max_iterations, max_pseudo_time, pseudo_time_step, t0, t)
+        with serial_blas():
+            return _relaxation(model, system, rtol, max_iterations, max_pseudo_time, pseudo_time_step, t0, t)
     finally:
         for sl, w in zip(model.windowed(), saved):
             sl.window = w

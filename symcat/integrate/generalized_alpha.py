@@ -296,11 +296,10 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
     wall0 = time.perf_counter()
     if multipliers not in ("kkt", "integrator"):
         raise ParameterError(f"multipliers={multipliers!r}: must be 'kkt' or 'integrator'")
-    # The per-step solves are small: BLAS threads only contend (10x slower on a busy 2-core machine).
-    from threadpoolctl import threadpool_limits
+    from ..threads import serial_blas
 
     try:
-        with threadpool_limits(limits=1, user_api="blas"):
+        with serial_blas():
             run = integrate_alpha(model, t_end, dt, rho_inf, variant, tol, max_iterations, n_out, progress, expand,
                                   max_halvings, monitor, handlers)
     except SolverError as err:

@@ -85,10 +85,9 @@ def integrate(line: CoupledLine, t_end: float, dt: float = 1e-3, rho_inf: float 
     """
     if not dt > 0:
         raise ParameterError(f"dt={dt:g} s: must be > 0")
-    # the banded solves are small: BLAS threads only contend (10x slower on a busy 2-core machine)
-    from threadpoolctl import threadpool_limits
+    from ..threads import serial_blas
 
-    with threadpool_limits(limits=1, user_api="blas"):
+    with serial_blas():
         return _integrate(line, t_end, dt, rho_inf, tol, max_iterations, record_every, progress, y0, contact_forces0)
 
 

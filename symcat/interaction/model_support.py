@@ -77,8 +77,8 @@ def passage_output(result: PassageResult, p: dict, stem: str, extra: dict | None
         summary["max_penetration_m"] = float(np.max(rec.penetration_m))
         if p.get("contact") == "bilateral":
             summary["max_constraint_violation_m"] = float(np.max(np.abs(rec.penetration_m[1:])))
-        if hasattr(rec, "energy_balance"):  # the interaction path's recorder
-            balance = rec.energy_balance()
+        balance = rec.energy_balance()
+        if balance is not None:
             summary["energy_balance_error_J"] = float(np.abs(balance["error_J"]).max())
             summary["contact_work_J"] = balance["work_scale_J"]
         summary["slack_dropper_events"] = int(np.sum(np.diff((rec.dropper_tension_N <= 0).astype(int), axis=0) == 1))

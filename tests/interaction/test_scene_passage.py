@@ -57,8 +57,12 @@ def test_seo2005_passage_has_the_lumped_summary_keys(passage):
                 "simulated_s", "wall_per_simulated_s", "max_penetration_m", "slack_dropper_events", "uplift_N",
                 "static_contact_force_N", "target_static_contact_force_N", "uplift_static_solves"):
         assert key in s, key
+    # the energy balance closes: what generalized-alpha's numerical dissipation took, a small
+    # part of the driving's work
+    assert s["contact_work_J"] > 1.0
+    assert s["energy_balance_error_J"] < 0.05 * s["contact_work_J"]
     # what this path does not compute is said, not left out silently
-    assert set(s["not_computed"]) >= {"energy_balance_error_J", "contact_work_J"}
+    assert set(s["not_computed"]) == {"newton_iterations_per_step"}
     # the lumped path's outputs, written for this one too
     names = {p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()}
     assert {"benchmark2015.npz", "benchmark2015_contact_force.png", "benchmark2015_panhead.png",
@@ -77,8 +81,8 @@ def test_static_contact_force_is_the_target(passage):
     s = run.summary
     rec = run.arrays["result"].record
     assert s["target_static_contact_force_N"] == pytest.approx(TARGET_N, rel=1e-12)
-    assert s["static_contact_force_N"] == pytest.approx(TARGET_N, rel=1e-6)
-    assert rec.contact_force_N[0, 0] == pytest.approx(TARGET_N, rel=1e-6)  # the integration starts from it
+    assert s["static_contact_force_N"] == pytest.approx(TARGET_N, rel=1e-5)
+    assert rec.contact_force_N[0, 0] == pytest.approx(TARGET_N, rel=1e-5)  # the integration starts from it
     assert 150.0 < s["uplift_N"] < 400.0  # the plunger uplift that carries the 22 kg frame and presses 130 N
     assert s["uplift_static_solves"] <= 6
 
@@ -94,7 +98,7 @@ def test_mean_contact_force_is_the_static_force(passage):
 def test_en50318_static_bilateral_on_the_unstaggered_wire():
     s = run_model("en50318", dict(pantograph="seo2005", contact="bilateral", n_spans=4, elements_per_span=8,
                                   analysis_spans=1, t_end=0.0, static_force_N=110.0, progress=False)).summary
-    assert s["static_contact_force_N"] == pytest.approx(110.0, rel=1e-6)
+    assert s["static_contact_force_N"] == pytest.approx(110.0, rel=1e-5)
     assert s["target_static_contact_force_N"] == 110.0 and s["uplift_N"] > 110.0
 
 
@@ -126,7 +130,7 @@ def test_a_users_own_pantograph_fragment():
 
     res = run_scene_passage(benchmark2015(4), ScenePantograph(mine, uplift=160.0, name="mine"), 200 / 3.6,
                             target_force=90.0, elements_per_span=8, analysis_spans=1, t_end=0.0, progress=False)
-    assert res.static_contact_force_N == pytest.approx(90.0, rel=1e-6)
+    assert res.static_contact_force_N == pytest.approx(90.0, rel=1e-5)
     # a vertical guide: the uplift carries the force, the weight and the suspension stretched by the rise
     model = res.model
     rise = model.q0[model.rigid_offset["head"] + 2] - model.scene.find("head").position[2]

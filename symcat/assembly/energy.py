@@ -1,0 +1,243 @@
+"""Mechanical energy of a multibody model and the power of what is not conservative in it: the
+two sides of a run's energy balance.
+
+The energy is ``E = T + V``: the kinetic energy and a potential ``V`` of every force that has one
+here: the wires' strain energy, gravity and the constant loads (:meth:`MultibodyModel.potential_energy`),
+the springs of :class:`~symcat.scene.SpringDamper` elements (``k e^2 / 2 + k3 e^4 / 4`` of the
+stretch ``e``; tension-only ones while stretched), the constant part ``F0`` of point loads
+(``-F0 . r``) and the penalty springs of wire contacts (``k p^2 / 2`` of the penetration ``p``;
+the smoothing of the law changes it by ``O(k delta^2)``). Over a run, ``E(t) - E(0)`` equals the
+work of the rest: the power
+
+``P = v . (Q_e + grad V_e) - v^T C v + lambda . C_t``
+
+summed over the force elements whose force is not the gradient of their potential here (dampers,
+time-varying loads and torques, rotational springs and bushings, contacts), then Rayleigh
+damping, then the work of the constraint forces, which only rheonomic constraints (prescribed
+motions: a train's speed) do: ``-v . C_q^T lambda = lambda . (C_s s_dot + C_t)``, and
+``C_s^T lambda = 0`` (a sliding joint is frictionless). A conservative element costs nothing
+per step; what an integrator gains or loses is ``E(t) - E(0) - int P dt``.
+"""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from ..codegen.library import BufferedFunction, kernel_library, library_interface
+from .sparse import to_scipy
+
+
+def _points(kind: str, y: ca.MX, u: np.ndarray) -> ca.MX:
+    """Global positions (3 x m) of the body points ``u`` (3 x m: body frame; ground: global)
+    of ``m`` sides whose coordinates are the columns of ``y`` (as the kernels: a node's point
+    is offset from its position, a rigid body's turns with its Euler parameters)."""
+    u_dm = ca.DM(u)
+    if kind == "ground":
+        return u_dm
+    if kind == "node":
+        return y[0:3, :] + u_dm
+    e0, e = y[3, :], y[4:7, :]
+    m = u.shape[1]
+    e_dot_u = ca.repmat(ca.sum1(e * u_dm), 3, 1)
+    cross = ca.vertcat(e[1, :] * u_dm[2, :] - e[2, :] * u_dm[1, :], e[2, :] * u_dm[0, :] - e[0, :] * u_dm[2, :],
+                       e[0, :] * u_dm[1, :] - e[1, :] * u_dm[0, :])
+    return y[0:3, :] + ca.repmat(2 * e0**2 - 1, 3, 1) * u_dm + 2 * (e * e_dot_u + ca.repmat(e0, 3, 1) * cross) \
+        if m else ca.MX(3, 0)
+
+
+_SIZES = {"ground": 0, "node": 3, "rigid": 7}
+
+
+def _group_potentials(library: str, y: ca.MX, par: dict) -> ca.MX | None:
+    """Potentials (J, 1 x m) of ``m`` force elements of ``library`` at their coordinates ``y``
+    (columns) with parameters ``par`` (name -> 1 x m values); None where they have none here
+    (their whole power is then counted as work)."""
+    def vec(name):
+        return np.vstack([par[f"{name}_{k}"] for k in range(3)])
+
+    if library.startswith("springdamper_"):
+        ka, kb = library.split("_")[1:3]
+        n_a = _SIZES[ka]
+        d = _points(kb, y[n_a:, :], vec("uj")) - _points(ka, y[:n_a, :], vec("ui"))
+        e = ca.sqrt(ca.sum1(d**2)) - ca.DM(par["l0"]).T
+        slack = ca.DM((par["tension_only"] > 0.5).astype(float)).T
+        e = slack * ca.fmax(e, 0.0) + (1 - slack) * e
+        return 0.5 * ca.DM(par["k"]).T * e**2 + 0.25 * ca.DM(par["k3"]).T * e**4
+    if library == "pointload_rigid":
+        return -ca.sum1(ca.DM(vec("F0")) * _points("rigid", y, vec("ui")))
+    return None
+
+
+def _conservative(library: str, par: dict) -> np.ndarray:
+    """Which elements' forces are exactly minus the gradient of :func:`_group_potentials`."""
+    m = len(next(iter(par.values())))
+    if library.startswith("springdamper_"):
+        return par["c"] == 0.0
+    if library == "pointload_rigid":
+        return np.all([par[f"{n}_{k}"] == 0.0 for n in ("F1", "T0", "T1") for k in range(3)], axis=0)
+    return np.zeros(m, bool)
+
+
+def penalty_law(pen: np.ndarray, k: np.ndarray, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Potential (J) and force (N) of the smoothed penalty law of the contact kernels without
+    damping, ``f = ramp(k ramp(p, delta), k delta)`` (:func:`symcat.codegen.multibody_kernels._ramp`),
+    at the penetrations ``p`` (m): ``f = k p^4 / (8 delta^3)`` up to ``delta``,
+    ``k (p - delta/2)^2 / (2 delta)`` up to ``3 delta / 2``, ``k (p - delta)`` beyond."""
+    u, d = np.asarray(pen, float), np.asarray(delta, float)
+    v_c1 = k * d**2 / 40
+    v_d1 = v_c1 + 7 * k * d**2 / 48
+    potential = np.select([u <= 0, u < d, u < 1.5 * d],
+                          [0.0, k * u**5 / (40 * d**3), v_c1 + k / (6 * d) * ((u - d / 2) ** 3 - (d / 2) ** 3)],
+                          v_d1 + k * (u - d) ** 2 / 2 - k * d**2 / 8)
+    force = np.select([u <= 0, u < d, u < 1.5 * d], [0.0, k * u**4 / (8 * d**3), k * (u - d / 2) ** 2 / (2 * d)],
+                      k * (u - d))
+    return potential, force
+
+
+class _ContactEnergy:
+    """The penalty contacts' potential and the power of their non-conservative part (damping,
+    and the normal held fixed in their generalized force), each contact evaluated on the
+    element that holds its point: the element windows of the model's graphs follow the
+    integrator, not this."""
+
+    def __init__(self, model):
+        self.contacts = []
+        built = {}
+        for ct in model.contacts:
+            if ct.library not in built:  # [q_loc, gap, d gap/d y, d T/d y] of one element and body
+                lib = kernel_library(ct.library)
+                n_y = lib[f"{ct.library}_tangency"].size1_in(0)
+                y, y_dot = ca.MX.sym("y", n_y), ca.MX.sym("y_dot", n_y - 1)
+                p = ca.MX.sym("p", lib[f"{ct.library}_tangency"].size1_in(1))
+                q_loc, gap, _ = lib[f"{ct.library}_force"](y, y_dot, p)
+                tangency = lib[f"{ct.library}_tangency"](y, p)
+                built[ct.library] = BufferedFunction(ca.Function(f"{ct.library}_energy_terms", [y, y_dot, p], [
+                    q_loc, gap, ca.densify(ca.jacobian(gap, y)), ca.densify(ca.jacobian(tangency, y))]))
+            names = list(library_interface(ct.library)["params"])
+            self.contacts.append((ct, np.array(model._rigid_indices(ct.body.name)), built[ct.library],
+                                  ct.params[names.index("k")], ct.params[names.index("delta")]))
+
+    def __call__(self, q, v, sc) -> tuple[float, float]:
+        """Potential (J) and non-conservative power (W) of all contacts."""
+        energy = power = 0.0
+        for (ct, rigid, terms, k, delta), s in zip(self.contacts, sc):
+            starts = ct.element_start
+            if not starts[0] <= s <= starts[-1]:
+                continue  # off its wire: no force (contact_terms)
+            e = int(np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(starts) - 2))
+            rows = ct.element_indices[e]
+            y = np.r_[q[rows], q[rigid], s - starts[e]]
+            y_dot = np.r_[v[rows], v[rigid]]
+            p = np.r_[starts[e + 1] - starts[e], ct.params[1:]]
+            q_loc, gap, g_y, t_y = (x.ravel() for x in terms(y, y_dot, p))
+            s_dot = -(t_y[:-1] @ y_dot) / t_y[-1]  # the tangency T(y) = 0 moves the point along the wire
+            pen_dot = -(g_y[:-1] @ y_dot + g_y[-1] * s_dot)
+            v_el, f_el = penalty_law(-float(gap.ravel()[0]), k, delta)
+            energy += float(v_el)
+            power += float(q_loc.ravel() @ y_dot + f_el * pen_dot)
+        return energy, power
+
+
+class EnergyTerms:
+    """Energy and non-conservative power of a :class:`~symcat.assembly.multibody.MultibodyModel`
+    (module docstring), as compiled-graph CasADi functions of the physical state.
+
+    Parameters
+    ----------
+    model : MultibodyModel
+    """
+
+    def __init__(self, model):
+        self.model = model
+        n_q, n_sc, n_a = model.n_q, len(model.contacts), model.ancf.n
+        q, v = ca.MX.sym("q", n_q), ca.MX.sym("v", n_q)
+        t = ca.MX.sym("t")
+        potential = model.potential_energy(q)
+        power = ca.MX(0)
+        for lib, group in model.force_groups.items():
+            rows, values = np.array(group.rows), np.array(group.params, float)
+            par = dict(zip(library_interface(lib)["params"], values.T))
+            v_pot = _group_potentials(lib, _gather(q, rows), par)
+            work = ~_conservative(lib, par)
+            if v_pot is not None:
+                potential += ca.sum2(v_pot)
+                if work.any():  # the element's power minus the rate of its potential
+                    power += ca.jtimes(ca.sum2(v_pot[:, np.flatnonzero(work).tolist()]), q, v)
+            if work.any():
+                w_rows = rows[work]
+                fn = kernel_library(lib)[lib].map(len(w_rows))
+                out = fn(_gather(q, w_rows), _gather(v, w_rows), t, ca.DM(values[work].T))
+                power += ca.dot(ca.vec(out), v[w_rows.ravel().tolist()])
+        if n_a and any(es.damped for es in model.ancf.element_sets):
+            f_v = model.ancf.force_function()(q[:n_a], v[:n_a]) - model.ancf.force_function()(q[:n_a], ca.MX.zeros(n_a))
+            power += ca.dot(f_v, v[:n_a])
+        self._contacts = _ContactEnergy(model) if n_sc else None
+        # evaluated in place on NumPy memory: a DM conversion of a line's state costs more
+        self._energy = BufferedFunction(ca.Function("energy", [q, v], [model.kinetic_energy(q, v), potential]))
+        self._power = BufferedFunction(ca.Function("power_nonconservative", [q, v, t], [power]))
+        c = model.ancf.rayleigh_matrix
+        self._rayleigh = None if c is None else to_scipy(model._rayleigh_dm()).tocsr()
+        # the rheonomic constraints' rows (prescribed motions): lambda . C_t
+        self._ct = self._constraint_rates(model, q, t)
+
+    @staticmethod
+    def _constraint_rates(model, q, t):
+        """``C_t`` of the constraint groups (the first rows; the sliding joints and wheel/rail
+        contacts that follow them are scleronomic) as a function of ``(q, t)``."""
+        parts = []
+        for lib, group in model.groups.items():
+            rows = np.array(group.rows)
+            p = ca.DM(np.array(group.params).T)
+            c_t = kernel_library(lib)[f"{lib}_jac"].map(len(rows))(_gather(q, rows), t, p)[1]
+            parts.append(ca.vec(c_t))
+        if not parts:
+            return None
+        return BufferedFunction(ca.Function("constraint_rates", [q, t], [ca.densify(ca.vertcat(*parts))]))
+
+    def energy(self, q: np.ndarray, v: np.ndarray, sc: np.ndarray | None = None) -> tuple[float, float]:
+        """Kinetic and potential energy (J) at coordinates ``q`` and velocities ``v`` (all of
+        the model's, ``model.coordinate_names()``) and contact arc lengths ``sc`` (m)."""
+        sc = np.zeros(0) if sc is None else sc
+        kinetic, potential = self._energy.nonzeros(q, v)
+        contact = self._contacts(q, v, sc)[0] if self._contacts is not None else 0.0
+        return float(kinetic[0]), float(potential[0]) + contact
+
+    def power(self, q: np.ndarray, v: np.ndarray, sc: np.ndarray | None, multipliers: np.ndarray,
+              t: float) -> tuple[float, float]:
+        """The work rates (W) at the state ``(q, v, sc)``, multipliers ``multipliers`` (the
+        model's constraint rows) and time ``t``: of the constraint forces (the prescribed
+        motions' driving) and of the non-conservative forces (dampers, time-varying loads,
+        Rayleigh damping; <= 0 when they only dissipate)."""
+        sc = np.zeros(0) if sc is None else sc
+        other = float(self._power.nonzeros(q, v, t)[0][0])
+        if self._contacts is not None:
+            other += self._contacts(q, v, sc)[1]
+        if self._rayleigh is not None:
+            other -= float(v @ (self._rayleigh @ v))
+        driving = 0.0
+        if self._ct is not None:
+            c_t = self._ct.nonzeros(q, t)[0]
+            driving = float(np.asarray(multipliers)[: c_t.size] @ c_t)
+        return driving, other
+
+
+def balance(t: np.ndarray, driving_W: np.ndarray, other_W: np.ndarray, t_energy: np.ndarray,
+            energy_J: np.ndarray) -> dict[str, np.ndarray]:
+    """The energy balance of a run: the energy (J) at ``t_energy`` against its start plus the
+    work since then (trapezoidal rule over the steps ``t`` of the powers, W). ``error_J`` is
+    what the time integration gained (> 0) or lost; ``work_scale_J`` the work of the
+    constraint forces in absolute value, the scale of the balance."""
+    t = np.asarray(t, float)
+    net = np.asarray(driving_W) + np.asarray(other_W)
+    cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (net[1:] + net[:-1]) * np.diff(t))])
+    expected = energy_J[0] + np.interp(t_energy, t, cumulative)
+    drive = np.abs(np.asarray(driving_W))
+    work = float(np.sum(0.5 * (drive[1:] + drive[:-1]) * np.diff(t)))
+    return {"t_s": np.asarray(t_energy), "energy_J": np.asarray(energy_J), "expected_J": expected,
+            "error_J": np.asarray(energy_J) - expected, "work_scale_J": work}
+
+
+def _gather(x: ca.MX, rows: np.ndarray) -> ca.MX:
+    rows = np.asarray(rows)
+    return ca.reshape(x[rows.ravel().tolist()], rows.shape[1], rows.shape[0])
+
