@@ -83,17 +83,13 @@ class PassageRecorder:
 
     def energy_balance(self) -> dict[str, np.ndarray]:
         """Energy (J) at the snapshots against the work done by the moving contacts minus the
-        damper dissipation since the start (trapezoidal rule over the steps). ``error_J`` is
-        what the time integration lost or gained (generalized-alpha with rho_inf < 1 damps)."""
-        t = np.asarray(self._rows["t_s"])
-        net = np.asarray(self._rows["work_power_W"]) - np.asarray(self._rows["dissipation_power_W"])
-        cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (net[1:] + net[:-1]) * np.diff(t))])
-        ts = self.snapshot_t_s
-        energy = np.asarray(self._snap_e)
-        expected = energy[0] + np.interp(ts, t, cumulative)
-        work = np.concatenate([[0.0], np.cumsum(0.5 * np.abs(np.asarray(self._rows["work_power_W"]))[1:] * np.diff(t))])
-        return {"t_s": ts, "energy_J": energy, "expected_J": expected, "error_J": energy - expected,
-                "work_scale_J": float(work[-1])}
+        damper dissipation since the start (:func:`symcat.assembly.energy.balance`, as the
+        multibody path's). ``error_J`` is what the time integration lost or gained
+        (generalized-alpha with rho_inf < 1 damps)."""
+        from ..assembly.energy import balance
+
+        return balance(self._rows["t_s"], self._rows["work_power_W"], -np.asarray(self._rows["dissipation_power_W"]),
+                       self.snapshot_t_s, np.asarray(self._snap_e))
 
     @property
     def static_support_z_m(self) -> np.ndarray:
