@@ -94,6 +94,26 @@ def penalty_law(pen: np.ndarray, k: np.ndarray, delta: np.ndarray) -> tuple[np.n
     return potential, force
 
 
+def _contact_terms(library: str) -> BufferedFunction:
+    """``(y, y_dot, p) -> (Q . y_dot, gap, d penetration / dt)`` of a contact kernel on one
+    element and body: the contact point moves along the wire as the tangency ``T(y) = 0``
+    holds it (``s_dot = -T_y y_dot / T_s``); the penetration's rate is a central difference of
+    the gap along ``[y_dot, s_dot]`` (exact to round-off for the energy balance, and a tenth of
+    the cost of the kernel's Jacobian, most of which is the generalized force's)."""
+    lib = kernel_library(library)
+    tangency_fn, force_fn = lib[f"{library}_tangency"], lib[f"{library}_force"]
+    n_y = tangency_fn.size1_in(0)
+    y, y_dot, p = ca.MX.sym("y", n_y), ca.MX.sym("y_dot", n_y - 1), ca.MX.sym("p", tangency_fn.size1_in(1))
+    q_loc, gap, _ = force_fn(y, y_dot, p)
+    t_y = ca.jacobian(tangency_fn(y, p), y)
+    s_dot = -ca.mtimes(t_y[:, : n_y - 1], y_dot) / t_y[:, n_y - 1]
+    w = ca.vertcat(y_dot, s_dot)
+    eps = 1e-7 / ca.fmax(ca.norm_inf(w), 1e-12)  # moves the point by 1e-7 m at most
+    gap_rate = (force_fn(y + eps * w, y_dot, p)[1] - force_fn(y - eps * w, y_dot, p)[1]) / (2 * eps)
+    return BufferedFunction(ca.Function(f"{library}_energy_terms", [y, y_dot, p],
+                                        [ca.dot(q_loc, y_dot), gap, -gap_rate]))
+
+
 class _ContactEnergy:
     """The penalty contacts' potential and the power of their non-conservative part (damping,
     and the normal held fixed in their generalized force), each contact evaluated on the
@@ -104,15 +124,8 @@ class _ContactEnergy:
         self.contacts = []
         built = {}
         for ct in model.contacts:
-            if ct.library not in built:  # [q_loc, gap, d gap/d y, d T/d y] of one element and body
-                lib = kernel_library(ct.library)
-                n_y = lib[f"{ct.library}_tangency"].size1_in(0)
-                y, y_dot = ca.MX.sym("y", n_y), ca.MX.sym("y_dot", n_y - 1)
-                p = ca.MX.sym("p", lib[f"{ct.library}_tangency"].size1_in(1))
-                q_loc, gap, _ = lib[f"{ct.library}_force"](y, y_dot, p)
-                tangency = lib[f"{ct.library}_tangency"](y, p)
-                built[ct.library] = BufferedFunction(ca.Function(f"{ct.library}_energy_terms", [y, y_dot, p], [
-                    q_loc, gap, ca.densify(ca.jacobian(gap, y)), ca.densify(ca.jacobian(tangency, y))]))
+            if ct.library not in built:
+                built[ct.library] = _contact_terms(ct.library)
             names = list(library_interface(ct.library)["params"])
             self.contacts.append((ct, np.array(model._rigid_indices(ct.body.name)), built[ct.library],
                                   ct.params[names.index("k")], ct.params[names.index("delta")]))
@@ -129,12 +142,10 @@ class _ContactEnergy:
             y = np.r_[q[rows], q[rigid], s - starts[e]]
             y_dot = np.r_[v[rows], v[rigid]]
             p = np.r_[starts[e + 1] - starts[e], ct.params[1:]]
-            q_loc, gap, g_y, t_y = (x.ravel() for x in terms(y, y_dot, p))
-            s_dot = -(t_y[:-1] @ y_dot) / t_y[-1]  # the tangency T(y) = 0 moves the point along the wire
-            pen_dot = -(g_y[:-1] @ y_dot + g_y[-1] * s_dot)
-            v_el, f_el = penalty_law(-float(gap.ravel()[0]), k, delta)
+            q_v, gap, pen_dot = (float(x[0]) for x in terms.nonzeros(y, y_dot, p))
+            v_el, f_el = penalty_law(-gap, k, delta)
             energy += float(v_el)
-            power += float(q_loc.ravel() @ y_dot + f_el * pen_dot)
+            power += q_v + float(f_el) * pen_dot
         return energy, power
 
 
