@@ -44,8 +44,9 @@ contact wire's static height at the support -6 mm.
 
 ``pantograph=seo2005`` runs the seed paper's four-body pantograph instead (scene bodies on the
 multibody path, :mod:`symcat.interaction.scene_passage`; penalty contact, as the wire is
-staggered, handed over between the sections' wires in overlaps; one pantograph;
-``pantograph=lumped_scene`` runs the lumped one there, one or two): its plunger uplift is trimmed so that the static
+staggered, handed over between the sections' wires in overlaps; one or two;
+``pantograph=lumped_scene`` runs the lumped one there, one or two, in penalty contact or in
+bilateral contact through a shoe that follows the stagger): its plunger uplift is trimmed so that the static
 contact force is the lumped pantograph's (``uplift_N`` or the EN 50367 target, plus the
 aerodynamic ``c v^2`` on the pan-head), and the summary reports that uplift (``uplift_N``).
 """

@@ -137,16 +137,28 @@ class _ContactEnergy:
             starts = ct.element_start
             if not starts[0] <= s <= starts[-1]:
                 continue  # off its wire: no force (contact_terms)
-            e = int(np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(starts) - 2))
+            e = min(max(int(np.searchsorted(starts, s, side="right")) - 1, 0), len(starts) - 2)
             rows = ct.element_indices[e]
-            y = np.r_[q[rows], q[rigid], s - starts[e]]
-            y_dot = np.r_[v[rows], v[rigid]]
-            p = np.r_[starts[e + 1] - starts[e], ct.params[1:]]
+            y = np.concatenate((q[rows], q[rigid], (s - starts[e],)))
+            y_dot = np.concatenate((v[rows], v[rigid]))
+            p = ct.params.copy()
+            p[0] = starts[e + 1] - starts[e]
             q_v, gap, pen_dot = (float(x[0]) for x in terms.nonzeros(y, y_dot, p))
-            v_el, f_el = penalty_law(-gap, k, delta)
-            energy += float(v_el)
-            power += q_v + float(f_el) * pen_dot
+            v_el, f_el = _penalty_scalar(-gap, k, delta)
+            energy += v_el
+            power += q_v + f_el * pen_dot
         return energy, power
+
+
+def _penalty_scalar(u: float, k: float, d: float) -> tuple[float, float]:
+    """:func:`penalty_law` of one penetration (the per-step path: NumPy's overhead is the cost)."""
+    if u <= 0:
+        return 0.0, 0.0
+    if u < d:
+        return k * u**5 / (40 * d**3), k * u**4 / (8 * d**3)
+    if u < 1.5 * d:
+        return k * d**2 / 40 + k / (6 * d) * ((u - d / 2) ** 3 - (d / 2) ** 3), k * (u - d / 2) ** 2 / (2 * d)
+    return k * d**2 / 40 + 7 * k * d**2 / 48 + k * (u - d) ** 2 / 2 - k * d**2 / 8, k * (u - d)
 
 
 class EnergyTerms:

@@ -108,8 +108,8 @@ PANTOGRAPH_CHOICES = ("lumped", "lumped_scene", "seo2005")
 PANTOGRAPH_PARAMETER = Parameter(
     "pantograph", "lumped", "", "pantograph model: lumped (the model's lumped-mass pantograph on the interaction "
     "path), lumped_scene (the same pantograph as scene bodies on the shared multibody path) or seo2005 (the seed "
-    "paper's four-body pantograph as scene bodies); on the multibody path overlaps and two pantographs (lumped_scene) "
-    "with penalty contact only, the uplift trimmed to the static contact force",
+    "paper's four-body pantograph as scene bodies); on the multibody path the uplift is trimmed to the static contact "
+    "force, overlaps need contact=penalty",
     choices=PANTOGRAPH_CHOICES)
 
 
@@ -132,14 +132,12 @@ def check_scene_pantograph(p: dict, stagger: float, n_pantographs: int = 1, tens
     if p.get("pantograph", "lumped") == "lumped":
         return
     name = f"pantograph={p['pantograph']}"
-    if n_pantographs != 1 and not (p["pantograph"] == "lumped_scene" and p["contact"] == "penalty"):
-        raise ParameterError(f"n_pantographs={n_pantographs} with {name} and contact={p['contact']}: this multibody "
-                             "pantograph runs alone (n_pantographs=1); two pantographs need pantograph=lumped, or "
-                             "pantograph=lumped_scene with contact=penalty")
     if tension_sections != 1 and p["contact"] == "bilateral":
         raise ParameterError(f"tension_sections={tension_sections} with {name} and contact=bilateral: a sliding joint "
                              "cannot pass an overlap; allowed: contact=penalty, or tension_sections=1")
-    if p["contact"] == "bilateral" and stagger != 0:
+    # the lumped pantograph's bilateral contact is a shoe sliding across its pan-head, which
+    # follows the stagger; the four-body pantograph's sliding joint is on its pan-head's centre
+    if p["contact"] == "bilateral" and stagger != 0 and p["pantograph"] != "lumped_scene":
         raise ParameterError(f"contact=bilateral with {name}: the contact wire is staggered (+/-{abs(stagger):g} m) "
                              "and the sliding joint would pull it onto the pantograph's plane; allowed: "
                              "contact=penalty")
@@ -170,7 +168,10 @@ def run_scene_pantograph(design, p: dict, speed: float, target_force: float, ste
                                     name="pantograph" if n == 1 else f"pantograph_{k + 1}") for k in range(n)]
         fragment = fragment[0] if n == 1 else fragment
     else:
-        fragment = seo2005_fragment(p["contact"], p["contact_stiffness"], p["contact_damping"], aero_force=aero_force)
+        n = p.get("n_pantographs", 1)
+        fragment = [seo2005_fragment(p["contact"], p["contact_stiffness"], p["contact_damping"], aero_force=aero_force,
+                                     prefix="pantograph_" if n == 1 else f"pantograph_{k + 1}_") for k in range(n)]
+        fragment = fragment[0] if n == 1 else fragment
     result = run_scene_passage(design, fragment, speed, target_force, elements_per_span=o["elements_per_span"],
                                element=o["element"], analysis_spans=o["analysis_spans"], dt=o["dt"],
                                rho_inf=o["rho_inf"], tol=o["tol"], t_end=o["t_end"], record_every=o["record_every"],

@@ -107,16 +107,20 @@ NOT_COMPUTED = {
 
 class SceneRecord:
     """Histories of a :func:`run_scene_passage`, under :class:`~.recorder.PassageRecorder`'s names
-    (one pantograph, one contact wire).
+    (``p`` pantographs, leading first; ``w`` contact wires of the tension sections).
 
     Attributes (NumPy arrays, SI units in the names)
     ------------------------------------------------
     t_s : (n,)
-    x_contact_m, contact_force_N, penetration_m, panhead_z_m, panhead_acc_m_s2 : (n, 1)
+    x_contact_m, contact_force_N, penetration_m, panhead_z_m, panhead_acc_m_s2 : (n, p)
         Pan-head position along the line, contact force, penetration (minus the normal gap;
         bilateral: the largest constraint violation of the step), height and vertical
         acceleration of the pan-head's body.
-    contact_force_wire_N : (n, 1, 1)
+    contact_force_wire_N : (n, p, w)
+    work_power_W, dissipation_power_W : (n,)
+        Power of the driving (the prescribed speed) and dissipated by the dampers.
+    energy_J : (n,)
+        Energy of the whole scene at the snapshots (NaN between them).
     support_z_m : (n, n_supports)
     dropper_tension_N : (n, n_droppers)
     snapshot_t_s : (n_snapshots,), snapshot_q : (n_snapshots, n_catenary_coordinates)
@@ -289,10 +293,11 @@ def _monitor(form, model, elements, energy, snapshot_every: float):
     return monitor
 
 
-def record_histories(res, form, model, element, snapshot_every: float, energy=None) -> dict:
+def record_histories(res, form, model, elements, snapshot_every: float, energy=None) -> dict:
     """The SceneRecord arrays of a SimulationResult (per-step values from its ``monitored``
-    records when there are, snapshots from its outputs); with ``energy`` (the model's
-    :class:`~symcat.assembly.energy.EnergyTerms`), the work rates at the outputs and the
+    records when there are, snapshots from its outputs), one column per pan-head contact of
+    ``elements`` (a list, leading pantograph first, or one element); with ``energy`` (the
+    model's :class:`~symcat.assembly.energy.EnergyTerms`), the work rates at the outputs and the
     energy at the snapshots, for the energy balance."""
     from ..scene import PenaltyContact
 
@@ -307,13 +312,18 @@ def record_histories(res, form, model, element, snapshot_every: float, energy=No
                 "contact_force_wire_N": m["contact_force_wire_N"], "support_z_m": m["support_z_m"],
                 "dropper_tension_N": m["dropper_tension_N"], "snapshot_t_s": np.asarray(res.t_s)[snap],
                 "snapshot_q": q[snap, : st.n]}
-    head = model.rigid_offset[element.body]
-    if isinstance(element, PenaltyContact):
-        c = res.contacts[element.name]
-        force, penetration = np.asarray(c["force_N"]), -np.asarray(c["gap_m"])
-    else:
-        force = -np.asarray(res.reactions_N[element.name])[:, 2]
-        penetration = np.asarray(res.position_drift)
+    elements = list(elements) if isinstance(elements, (list, tuple)) else [elements]
+    heads = np.array([model.rigid_offset[e.body] for e in elements])
+    force, penetration = [], []
+    for e in elements:
+        if isinstance(e, PenaltyContact):
+            c = res.contacts[e.name]
+            force.append(np.asarray(c["force_N"]))
+            penetration.append(-np.asarray(c["gap_m"]))
+        else:  # a sliding joint: its reaction on the pan-head, the largest constraint violation
+            force.append(-np.asarray(res.reactions_N[e.name])[:, 2])
+            penetration.append(np.asarray(res.position_drift))
+    force, penetration = np.array(force).T, np.array(penetration).T
     t = np.asarray(res.t_s)
     snap = _snapshots(t, snapshot_every)
     q_cat = q[:, : st.n]
@@ -328,12 +338,12 @@ def record_histories(res, form, model, element, snapshot_every: float, energy=No
     return {
         **extra,
         "t_s": t,
-        "x_contact_m": q[:, head][:, None],
-        "contact_force_N": force[:, None],
-        "contact_force_wire_N": force[:, None, None],
-        "penetration_m": penetration[:, None],
-        "panhead_z_m": q[:, head + 2][:, None],
-        "panhead_acc_m_s2": np.asarray(res.a)[:, head + 2][:, None],
+        "x_contact_m": q[:, heads],
+        "contact_force_N": force,
+        "contact_force_wire_N": force[:, :, None],
+        "penetration_m": penetration,
+        "panhead_z_m": q[:, heads + 2],
+        "panhead_acc_m_s2": np.asarray(res.a)[:, heads + 2],
         "support_z_m": q_cat[:, st.cw_xyz[st.support_nodes, 2]],
         "dropper_tension_N": np.array([st.dropper_state(qk)[2] for qk in q_cat]),
         "snapshot_t_s": t[snap],
@@ -422,9 +432,6 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
                                                                      speed, force_rtol, wires=wires)
     from ..scene import PenaltyContact
 
-    if n_p > 1 and not all(isinstance(e, PenaltyContact) for e in elements):
-        raise ParameterError(f"{n_p} pantographs on the multibody path: their contacts must be penalty contacts "
-                             "(a sliding joint's force is read from outputs of one pantograph only)")
     eq.apply(model)
     line = SceneLine(form, speed, contact, model.n_q, None, positions)
     out = ScenePassageResult(form, line, None, section, [], uplifts[0] if n_p == 1 else uplifts,
@@ -439,9 +446,14 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
 
     energy = EnergyTerms(model)
     monitor = _monitor(form, model, elements, energy, record_every) if isinstance(elements[0], PenaltyContact) else None
-    # Snapshots every `per` steps, `per` a divisor of the steps: the step stays dt exactly.
-    per = max(d for d in range(1, max(1, round(record_every / dt)) + 1) if n_steps % d == 0)
-    n_out = n_steps if monitor is None else n_steps // per
+    # Snapshots every `per` steps, between half and all of the snapshot interval: a divisor of
+    # the steps if there is one (the step stays duration / n_steps), else the fewest steps added
+    # (generalized-alpha fits a whole number of steps per output by shortening the step). A
+    # divisor searched below (a prime number of steps would make every step an output, and
+    # their post-processing cost more than the run) is not needed.
+    target = max(1, round(record_every / dt))
+    per = min(range(max(1, target // 2), target + 1), key=lambda d: (d * math.ceil(n_steps / d) - n_steps, -d))
+    n_out = n_steps if monitor is None else math.ceil(n_steps / per)
     # Penalty contacts: the contact force is a function of the state, which the index-3 form
     # integrates to order 2 with half the multiplier unknowns of the stabilized one (the same
     # statistics to 1e-9 on the benchmark, 13 % less wall time); a sliding joint's force is a
@@ -449,7 +461,7 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
     variant = "index3" if monitor is not None else "stabilized"
     res = generalized_alpha(model, duration, dt, rho_inf, variant=variant, n_out=n_out, tol=tol, progress=progress,
                             multipliers="integrator", monitor=monitor)  # no KKT solve per output
-    rec = SceneRecord(record_histories(res, form, model, elements[0], record_every, energy), form, speed,
+    rec = SceneRecord(record_histories(res, form, model, elements, record_every, energy), form, speed,
                       dict(res.stats))
     rec.uplift_N, rec.static_contact_force_N = out.uplift_N, out.static_contact_force_N
     line._record = rec
