@@ -165,6 +165,10 @@ class _BulkForces:
         self._n_q, self._n_a = model.n_q, model.ancf.n
         p = to_scipy(form.P).tocsc()[:, :n_b]
         self._to_q, self._to_free = p.tocsr(), p.T.tocsr()
+        # Without Cholesky coordinates P picks coordinates: indexing, not two sparse products
+        # of the line's size per evaluation.
+        picks = np.all(np.diff(p.indptr) == 1) and np.all(p.data == 1.0)
+        self._picked = p.indices.copy() if picks else None
         self._q_fixed = np.array(form.q_fixed, float).ravel()
         q, v = ca.MX.sym("q", self._n_a), ca.MX.sym("v", self._n_a)
         system = model.ancf
@@ -190,8 +194,13 @@ class _BulkForces:
             self._groups.append((BufferedFunction(_expanded(fn, expand)), flat))
 
     def __call__(self, y_b: np.ndarray, v_b: np.ndarray, t: float) -> np.ndarray:
-        q = self._q_fixed + self._to_q @ y_b
-        v = self._to_q @ v_b
+        picked = self._picked
+        if picked is None:
+            q, v = self._q_fixed + self._to_q @ y_b, self._to_q @ v_b
+        else:
+            q, v = self._q_fixed.copy(), np.zeros(self._n_q)
+            q[picked] += y_b
+            v[picked] = v_b
         f = np.zeros(self._n_q)
         if self._linear is not None:
             f_ref, k_ref, q_ref = self._linear
@@ -200,7 +209,7 @@ class _BulkForces:
             f[: self._n_a] = self._ancf(q[: self._n_a], v[: self._n_a])[0].ravel()
         for fn, flat in self._groups:
             f += np.bincount(flat, fn(q[flat], v[flat], t)[0].ravel(), minlength=self._n_q)
-        return self._to_free @ f
+        return self._to_free @ f if picked is None else f[picked]
 
 
 def _expanded(fn: ca.Function, expand: bool) -> ca.Function:
