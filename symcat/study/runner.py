@@ -16,6 +16,7 @@ import importlib.util
 import logging
 import os
 import re
+import socket
 import sys
 import time
 
@@ -71,7 +72,7 @@ class StudyProgress:
 def _quiet_logs() -> None:
     for name in ("distributed", "distributed.nanny", "distributed.scheduler", "distributed.worker",
                  "distributed.core", "distributed.comm"):
-        logging.getLogger(name).setLevel(logging.ERROR)
+        logging.getLogger(name).setLevel(logging.CRITICAL)  # what matters is in the rows
 
 
 @contextlib.contextmanager
@@ -99,7 +100,7 @@ def connect(scheduler: str = "local", workers: int | None = None):
             # the dashboard needs bokeh (not a dependency): served when it is installed
             board = ":0" if importlib.util.find_spec("bokeh") is not None else None
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=board, worker_dashboard_address=None,
-                                   silence_logs=logging.ERROR)
+                                   silence_logs=logging.CRITICAL)
             client = Client(cluster)
         try:
             yield client
@@ -107,9 +108,18 @@ def connect(scheduler: str = "local", workers: int | None = None):
             client.close()
             cluster.close()
         return
+    host, port = scheduler[len("tcp://"):].rsplit(":", 1)
+    t0 = time.perf_counter()
+    try:  # a refused or unknown address is told at once, not after the client's retries
+        socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT_S).close()
+    except OSError as err:
+        reason = err.strerror or type(err).__name__
+        raise ParameterError(f"--scheduler {scheduler}: cannot reach it ({reason}); start a scheduler "
+                             "(`dask scheduler`) or give its address") from None
+    left = max(1.0, CONNECT_TIMEOUT_S - (time.perf_counter() - t0))
     try:
-        client = Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S:g}s")
-    except (OSError, TimeoutError) as err:
+        client = Client(scheduler, timeout=f"{left:g}s")
+    except Exception as err:  # refused, timed out, or something else answering there
         raise ParameterError(f"--scheduler {scheduler}: no Dask scheduler answered within {CONNECT_TIMEOUT_S:g} s "
                              f"({type(err).__name__}); start one (`dask scheduler`) or give its address") from None
     try:
@@ -165,8 +175,20 @@ def execute(client, model_ref: str, runs, on_row, out_dir=None, progress: bool =
         return client.submit(run_one, model_ref, run.params, out, key=f"symcat-run-{run.run_id}-{attempt}",
                              pure=False)
 
-    futures = {submit(run, 0): (run, 0) for run in runs}
-    pending = as_completed(list(futures))
+    # As many runs in flight as there are worker threads: a worker holds only the run it is
+    # doing (a killed one loses only that), whatever the scheduler's queuing settings.
+    waiting = [(run, 0) for run in runs][::-1]
+    futures: dict = {}
+    pending = as_completed()
+
+    def top_up():
+        while waiting and len(futures) < max(1, slots(client)):
+            run, attempt = waiting.pop()
+            fut = submit(run, attempt)
+            futures[fut] = (run, attempt)
+            pending.add(fut)
+
+    top_up()
     try:
         for fut in pending:
             run, attempt = futures.pop(fut)
@@ -174,9 +196,8 @@ def execute(client, model_ref: str, runs, on_row, out_dir=None, progress: bool =
                 row = fut.result()
             except Exception as err:  # the worker died (KilledWorker) or the task could not run there
                 if attempt == 0:
-                    new = submit(run, 1)
-                    futures[new] = (run, 1)
-                    pending.add(new)
+                    waiting.append((run, 1))
+                    top_up()
                     continue
                 line = (str(err).strip().splitlines() or [""])[0]
                 row = {"status": "lost", "error": f"{type(err).__name__}: {line}"[:500], "summary": {},
@@ -186,6 +207,7 @@ def execute(client, model_ref: str, runs, on_row, out_dir=None, progress: bool =
             row["attempts"] = attempt + 1
             done += 1
             failed += row["status"] != "ok"
+            top_up()
             on_row(run, row)
             bar.update(done, failed)
         bar.update(done, failed, force=bar.shown)

@@ -66,10 +66,13 @@ def run_one(model_ref: str, params: dict, out: str | None = None) -> dict:
             model = _MODELS[model_ref] = load_model(model_ref)
         result = run_model(model, params, out=out)
         row["summary"] = flatten(result.summary)
-    except RunStopped as stop:
+    except RunStopped as stop:  # the reason, without run_model's pointer to where the partial results are
         row.update(status="failed", error=_line(stop))
         if stop.partial is not None:
             row["summary"] = flatten(stop.partial.summary)
+            reason = (stop.partial.summary.get("stopped") or {}).get("reason")
+            if reason:
+                row["error"] = str(reason).strip().splitlines()[0][:MAX_ERROR]
     except Exception as err:  # a failed run is a row with its error; the study goes on
         row.update(status="failed", error=_line(err))
     row["run_wall_s"] = time.perf_counter() - t0
