@@ -55,8 +55,14 @@ def test_the_same_seed_gives_the_same_table_and_another_seed_another(client):
 
 
 def test_a_failing_run_is_a_row_with_its_error(client, tmp_path):
-    result = run_study(TOY, {"fail_above": 2.5}, {"x": "1:4:1"}, client=client, out=tmp_path, progress=False)
+    import symcat
+
+    result = symcat.study(TOY, {"fail_above": 2.5}, {"x": "1:4:1"}, client=client, out=tmp_path, progress=False,
+                          keep_outputs=True)
     table = result.table
+    for run_id, status in zip(table["run_id"], table["status"]):  # each run's own --out, failed ones too
+        kept = json.loads((tmp_path / "runs" / run_id / "summary.json").read_text())
+        assert kept["complete"] is (status == "ok")
     assert list(table["status"]) == ["ok", "ok", "failed", "failed"]
     assert table["error"].iloc[2] == "toy solver: x=3 m is above fail_above=2.5 m"
     assert table["error"].iloc[0] == "" and table["y_m2"].iloc[1] == 4.0
@@ -123,3 +129,15 @@ def test_an_out_folder_of_another_study_is_refused(client, tmp_path, capsys):
     assert err.count("\n") == 1
     assert f"--out {tmp_path}: holds a study of different parameters (grid: " in err
     assert sorted(p.name for p in tmp_path.rglob("*")) == before
+
+
+def test_progress_shows_done_failed_running_and_time_left(capsys):
+    from symcat.study.runner import StudyProgress
+
+    bar = StudyProgress(10, 2, slots=2, delay=0.0)
+    bar.update(3, 0)
+    time.sleep(0.25)
+    bar.update(5, 1)
+    bar.close()
+    line = capsys.readouterr().err.strip().split("\r")[-1]
+    assert "5/10 runs, 1 failed, 2 running" in line and "eta" in line and "eta --" not in line
