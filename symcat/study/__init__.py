@@ -174,7 +174,8 @@ def run_study(model: str, set: dict | None = None, grid=None, random=None, sampl
     if folder is not None and plots and len(frame):
         from .plots import plot_study
 
-        files += plot_study(frame, list(spec.grids), [r.name for r in spec.randoms], folder.path / "plots")
+        params = sorted({k for row in ordered for k in row.get("params", {})})
+        files += plot_study(frame, list(spec.grids), [r.name for r in spec.randoms], folder.path / "plots", params)
     return StudyResult(frame, None if folder is None else folder.path, files, len(todo), len(runs) - len(todo), board)
 
 

@@ -36,8 +36,9 @@ def statistics_columns(frame, params: list[str]) -> list[str]:
     return cols
 
 
-def plot_study(frame, grids: list[str], randoms: list[str], folder: Path) -> list[Path]:
-    """Write the figures of ``frame`` (the study table) into ``folder``; their paths."""
+def plot_study(frame, grids: list[str], randoms: list[str], folder: Path, params: list[str] = ()) -> list[Path]:
+    """Write the figures of ``frame`` (the study table) into ``folder``; their paths.
+    ``params``: every parameter column (not plotted as a statistic, e.g. ``deviation_seed``)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -45,7 +46,7 @@ def plot_study(frame, grids: list[str], randoms: list[str], folder: Path) -> lis
 
     ok = frame[frame["status"] == "ok"]
     swept = list(grids) + list(randoms)
-    stats = statistics_columns(ok, swept)
+    stats = statistics_columns(ok, swept + list(params))
     files = []
     if ok.empty or not stats:
         return files

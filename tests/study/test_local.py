@@ -141,3 +141,30 @@ def test_progress_shows_done_failed_running_and_time_left(capsys):
     bar.close()
     line = capsys.readouterr().err.strip().split("\r")[-1]
     assert "5/10 runs, 1 failed, 2 running" in line and "eta" in line and "eta --" not in line
+
+
+def test_a_study_stopped_by_ctrl_c_resumes_where_it_stopped(client, tmp_path):
+    """A real interruption: `symcat study` on one worker gets SIGINT while the run x=4 is under way."""
+    import subprocess
+    import sys
+
+    hang, out = tmp_path / "hang", tmp_path / "study"
+    hang.mkdir()
+    cmd = [sys.executable, "-m", "symcat.cli", "study", TOY, "--grid", "x=1:6:1", "--set", "hang_at=4",
+           "--set", f"hang_dir={hang}", "--workers", "1", "--out", str(out), "--quiet"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not (hang / "pid").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert err.strip().splitlines()[-1] == (f"symcat: interrupted; the finished runs are in {out}: rerun the same "
+                                            "command to resume")
+    assert len(list((out / "rows").glob("*.json"))) == 3  # x = 1, 2, 3
+    assert list(pd.read_parquet(out / "results.parquet")["x"]) == [1.0, 2.0, 3.0]
+    (hang / "marker").write_text("")  # x=4 runs through this time
+    # the same study again (from Python, on the shared cluster: the same runs)
+    again = run_study(TOY, {"hang_at": "4", "hang_dir": str(hang)}, ["x=1:6:1"], client=client, out=out, progress=False)
+    assert (again.ran, again.skipped, again.failed) == (3, 3, 0)
+    assert list(pd.read_parquet(out / "results.parquet")["y_m2"]) == [1.0, 4.0, 9.0, 16.0, 25.0, 36.0]
