@@ -112,6 +112,11 @@ def connect(scheduler: str = "local", workers: int | None = None):
             client = Client(cluster)
         try:
             yield client
+        except BaseException:  # Ctrl-C or an error: stop the workers' runs now, not after Dask's 4 s of grace
+            with contextlib.suppress(Exception):
+                for nanny in list(cluster.workers.values()):
+                    cluster.sync(nanny.kill, timeout=0.5)
+            raise
         finally:
             client.close()
             cluster.close()
