@@ -85,7 +85,7 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
                        help="a local cluster (default) or an existing Dask scheduler")
     study.add_argument("--workers", type=int, metavar="N", help="local workers (default: one per core); with "
                        "tcp://, wait for N workers")
-    study.add_argument("--out", help="the study folder (see below)")
+    study.add_argument("--out", metavar="DIR", help="the study folder (see below)")
     study.add_argument("--keep-outputs", action="store_true", help="keep each run's files in DIR/runs/")
     study.add_argument("--quiet", action="store_true", help="no progress bar, no table on stdout")
     sub.add_parser("list", help="list the available models")
