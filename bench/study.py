@@ -28,15 +28,16 @@ OVERHEAD_TARGET_S = 0.2
 OVERHEAD_RUNS = 60
 
 
-def _serial(speeds: list[float]) -> float:
+def _serial(speeds: list[float]) -> tuple[float, float]:
+    """Wall and CPU time (s) of the runs one after the other in this process."""
     from symcat.model import load_model, run_model
 
     model = load_model("benchmark2015")
     run_model(model, {**ONE_PERCENT, "speed_kmh": speeds[0], "t_end": 0.05})  # warm: kernels loaded
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     for v in speeds:
         run_model(model, {**ONE_PERCENT, "speed_kmh": v})
-    return time.perf_counter() - t0
+    return time.perf_counter() - t0, time.process_time() - cpu0
 
 
 def measure() -> dict:
@@ -47,7 +48,7 @@ def measure() -> dict:
 
     speeds = parse_grid(load_model("benchmark2015"), f"speed_kmh={SPEEDS}")[1]
     load_before = os.getloadavg()[0]
-    serial = _serial(speeds)
+    serial, serial_cpu = _serial(speeds)
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
         with connect("local", WORKERS) as client:
@@ -65,7 +66,12 @@ def measure() -> dict:
                                 client=client, out=Path(tmp) / "instant", progress=False, plots=False)
             overhead_wall = time.perf_counter() - t1
     busy = float(instant.table["run_wall_s"].sum())
-    return {"load": (load_before, os.getloadavg()[0]),
+    # On an idle machine each worker has its core: the study's wall would be its busiest worker's CPU
+    # time plus the engine's share (its wall not spent in runs).
+    cpu = study.table.groupby("worker")["run_cpu_s"].sum()
+    engine = parallel - float(study.table.groupby("worker")["run_wall_s"].sum().max())
+    return {"load": (load_before, os.getloadavg()[0]), "serial_cpu_s": serial_cpu,
+            "idle_estimate_s": float(cpu.max()) + max(engine, 0.0), "worker_cpu_s": float(cpu.sum()),
             "busy": float(study.table["run_wall_s"].sum()) / (WORKERS * parallel), "serial_s": serial, "parallel_s": parallel, "cold_s": cold, "cluster_start_s": up,
             "failed": study.failed, "run_walls": list(study.table["run_wall_s"]),
             "overhead_s": (WORKERS * overhead_wall - busy) / OVERHEAD_RUNS, "instant_run_s": busy / OVERHEAD_RUNS}
@@ -96,6 +102,11 @@ def section(report_dir=None) -> list[str]:
         f"The workers were busy with runs {m['busy']:.0%} of the study's wall time (the rest is the engine's); "
         f"the machine's load average was {m['load'][0]:.1f} before and {m['load'][1]:.1f} after on "
         f"{os.cpu_count()} cores (above 1, other work shares the cores and the runs on two workers slow down).",
+        "",
+        f"CPU time, which other work on the machine does not inflate: serial {m['serial_cpu_s']:.1f} s, the "
+        f"workers {m['worker_cpu_s']:.1f} s for the same runs. The study's wall on an idle machine, estimated as its "
+        f"busiest worker's CPU time plus the engine's share of the wall: {m['idle_estimate_s']:.1f} s, "
+        f"{m['idle_estimate_s'] / m['serial_cpu_s']:.2f} of the serial CPU time.",
         "",
         f"Overhead per run (scheduling, serialization, result collection, the row written), from {OVERHEAD_RUNS} "
         f"instant `taut_wire` runs ({m['instant_run_s'] * 1e3:.0f} ms each on the worker): "

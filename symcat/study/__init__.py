@@ -30,8 +30,8 @@ class StudyResult:
     ----------
     table : pandas.DataFrame
         One row per run, in the study's order: ``run_id``, ``index``, ``grid_point``,
-        ``sample``, ``status`` (``ok``, ``failed``, ``lost``), ``error``, ``run_wall_s`` (s),
-        ``attempts``, ``worker``, the parameters, then every scalar summary entry.
+        ``sample``, ``status`` (``ok``, ``failed``, ``lost``), ``error``, ``run_wall_s`` and
+        ``run_cpu_s`` (s), ``attempts``, ``worker``, the parameters, then every scalar summary entry.
     out : Path or None
         The study folder.
     files : list of Path

@@ -104,7 +104,9 @@ def connect(scheduler: str = "local", workers: int | None = None):
         n = workers or os.cpu_count() or 1
         with dask.config.set({"distributed.scheduler.allowed-failures": 0,
                               "distributed.scheduler.worker-saturation": 1.0,
-                              "distributed.nanny.pre-spawn-environ": LOCAL_WORKER_ENVIRON}):
+                              "distributed.nanny.pre-spawn-environ": LOCAL_WORKER_ENVIRON,
+                              # the statistical profiler samples the running thread every 10 ms
+                              "distributed.worker.profile.enabled": False}):
             # the dashboard needs bokeh (not a dependency): served when it is installed
             board = ":0" if importlib.util.find_spec("bokeh") is not None else None
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=board, worker_dashboard_address=None,
@@ -214,7 +216,7 @@ def execute(client, model_ref: str, runs, on_row, out_dir=None, progress: bool =
                     continue
                 line = (str(err).strip().splitlines() or [""])[0]
                 row = {"status": "lost", "error": f"{type(err).__name__}: {line}"[:500], "summary": {},
-                       "run_wall_s": None, "worker": None}
+                       "run_wall_s": None, "run_cpu_s": None, "worker": None}
             finally:
                 fut.release()
             row["attempts"] = attempt + 1

@@ -23,7 +23,7 @@ RUNS_DIR = "runs"
 #: worker died twice ("lost") is run again.
 FINISHED = ("ok", "failed")
 #: Columns every row has besides the parameters and the summary.
-META = ("run_id", "index", "grid_point", "sample", "status", "error", "run_wall_s", "attempts", "worker")
+META = ("run_id", "index", "grid_point", "sample", "status", "error", "run_wall_s", "run_cpu_s", "attempts", "worker")
 
 
 def _differences(old: dict, new: dict) -> str:

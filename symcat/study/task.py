@@ -52,13 +52,14 @@ def run_one(model_ref: str, params: dict, out: str | None = None) -> dict:
     dict
         ``status`` (``"ok"`` or ``"failed"``), ``error`` (one line, ``""`` if none),
         ``summary`` (the flattened scalar summary; what was computed for a run stopped by its
-        solver), ``run_wall_s`` (s, the whole run on the worker, model loading included) and
-        ``worker`` (host:pid).
+        solver), ``run_wall_s`` (s, the whole run on the worker, model loading included),
+        ``run_cpu_s`` (s, the CPU time of the worker's process meanwhile: on a machine shared
+        with other work it tells the run's cost apart from its waiting) and ``worker`` (host:pid).
     """
     from ..errors import RunStopped
     from ..model import load_model, run_model
 
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     row = {"status": "ok", "error": "", "summary": {}}
     try:
         model = _MODELS.get(model_ref)
@@ -76,5 +77,6 @@ def run_one(model_ref: str, params: dict, out: str | None = None) -> dict:
     except Exception as err:  # a failed run is a row with its error; the study goes on
         row.update(status="failed", error=_line(err))
     row["run_wall_s"] = time.perf_counter() - t0
+    row["run_cpu_s"] = time.process_time() - cpu0
     row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     return row

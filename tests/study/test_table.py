@@ -21,8 +21,8 @@ def test_columns_keep_one_type_and_parameters_shadowing_summary_keys_are_kept_ap
     assert frame["force_N"].dtype.kind == "f" and frame["force_N"].isna().iloc[2]
     assert list(frame["label"].iloc[:2]) == ["a", "3"]  # text and a number: stored as text
     assert list(frame["summary.speed_kmh"].iloc[:2]) == [250.0, 260.0] and "speed_kmh" in frame.columns
-    assert list(frame.columns[:9]) == ["run_id", "index", "grid_point", "sample", "status", "error", "run_wall_s",
-                                       "attempts", "worker"]
+    assert list(frame.columns[:10]) == ["run_id", "index", "grid_point", "sample", "status", "error", "run_wall_s",
+                                        "run_cpu_s", "attempts", "worker"]
 
 
 def test_statistics_plotted_are_the_varying_numeric_summary_entries(tmp_path):
