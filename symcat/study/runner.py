@@ -1,12 +1,12 @@
 """Running a study's runs on Dask: a local cluster or an existing one, retries, progress.
 
 ``local`` starts a ``LocalCluster`` of single-threaded worker processes (one per core unless
-``workers`` says otherwise), each run a task. On this cluster a worker that dies (killed, out of
-memory) fails its task at once (``allowed-failures`` 0) and the scheduler gives each worker one
-task at a time (``worker-saturation`` 1.0), so a killed worker loses only the run it was doing;
-the runner submits that run once more, and records it as ``lost`` if it dies again. An existing
-cluster (``tcp://HOST:PORT``) keeps its own scheduler settings: with Dask's defaults a dead
-worker's tasks are retried by the scheduler itself up to three times before the runner's one
+``workers`` says otherwise), each run a task. The runner keeps as many runs in flight as there
+are worker threads, so a worker holds only the run it is doing and a killed worker loses only
+that run; on the local cluster a worker that dies fails its task at once (``allowed-failures``
+0), the runner submits that run once more and records it as ``lost`` if it dies again. An
+existing cluster (``tcp://HOST:PORT``) keeps its own scheduler settings: with Dask's defaults a
+dead worker's task is retried by the scheduler itself up to three times before the runner's one
 retry.
 """
 from __future__ import annotations
@@ -109,8 +109,8 @@ def connect(scheduler: str = "local", workers: int | None = None):
                               "distributed.worker.profile.enabled": False}):
             # the dashboard needs bokeh (not a dependency): served when it is installed
             board = ":0" if importlib.util.find_spec("bokeh") is not None else None
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=board, worker_dashboard_address=None,
-                                   silence_logs=logging.CRITICAL)
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=board,
+                                   worker_dashboard_address=None, silence_logs=logging.CRITICAL)
             client = Client(cluster)
         try:
             yield client
