@@ -103,7 +103,8 @@ def section(report_dir=None) -> list[str]:
         f"the machine's load average was {m['load'][0]:.1f} before and {m['load'][1]:.1f} after on "
         f"{os.cpu_count()} cores (above 1, other work shares the cores and the runs on two workers slow down).",
         "",
-        f"CPU time, which other work on the machine does not inflate: serial {m['serial_cpu_s']:.1f} s, the "
+        "CPU time, which other work on the machine inflates less than wall time (it still shares caches and "
+        f"cores): serial {m['serial_cpu_s']:.1f} s, the "
         f"workers {m['worker_cpu_s']:.1f} s for the same runs. The study's wall on an idle machine, estimated as its "
         f"busiest worker's CPU time plus the engine's share of the wall: {m['idle_estimate_s']:.1f} s, "
         f"{m['idle_estimate_s'] / m['serial_cpu_s']:.2f} of the serial CPU time.",
