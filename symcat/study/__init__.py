@@ -63,10 +63,9 @@ def prepare(model, set=None, grid=None, random=None, samples: int = 1, seed: int
         Bad input (one line naming the option, the value and what is allowed); nothing is
         written.
     """
+    from ..errors import ParameterError
     from ..model import load_model
     from .table import StudyFolder
-
-    from ..errors import ParameterError
 
     if not isinstance(model, str):
         raise ParameterError(f"model={getattr(model, 'name', model)!r}: give the model by name or file path "
