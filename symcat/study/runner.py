@@ -222,8 +222,8 @@ def execute(client, model_ref: str, runs, on_row, out_dir=None, progress: bool =
             row["attempts"] = attempt + 1
             done += 1
             failed += row["status"] != "ok"
+            on_row(run, row)  # recorded before the next run starts: an interruption keeps it
             top_up()
-            on_row(run, row)
             bar.update(done, failed)
         bar.update(done, failed, force=bar.shown)
     finally:
