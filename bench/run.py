@@ -227,6 +227,10 @@ def main():
     from bench.model_dae import section as model_dae_section
 
     model_dae = model_dae_section(REPORT)
+    print("studies on Dask ...", flush=True)
+    from bench.study import section as study_section
+
+    study = study_section(REPORT)
     lines = [
         "# symcat benchmark report",
         "",
@@ -285,6 +289,7 @@ def main():
         *wheelset,
         *vehicle,
         *model_dae,
+        *study,
     ]
     (REPORT / "README.md").write_text("\n".join(lines))
     print(f"wrote {REPORT / 'README.md'}")

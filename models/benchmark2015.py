@@ -49,10 +49,17 @@ staggered, handed over between the sections' wires in overlaps; one or two;
 bilateral contact through a shoe that follows the stagger): its plunger uplift is trimmed so that the static
 contact force is the lumped pantograph's (``uplift_N`` or the EN 50367 target, plus the
 aerodynamic ``c v^2`` on the pan-head), and the summary reports that uplift (``uplift_N``).
+
+As built: ``dropper_length_sd_m``, ``support_height_sd_m``, ``contact_wire_irregularity_m`` (with
+``irregularity_correlation_m``) and ``deviation_seed`` build the form-found line with sampled
+errors (:mod:`symcat.catenary.deviations`; lumped pantograph); the summary then adds the realized
+static height deviation ``as_built_height_rms_m``. ``symcat study ... --samples N --seed S`` draws
+one ``deviation_seed`` per sample.
 """
 from __future__ import annotations
 
 from symcat.catenary import benchmark2015
+from symcat.catenary.deviations import DEVIATION_PARAMETERS, as_built_form
 from symcat.catenary.design import DROPPER_STATICS, STEADY_ARM_CONVENTIONS
 from symcat.errors import ParameterError
 from symcat.interaction.model_support import (
@@ -97,7 +104,7 @@ PARAMETERS = [
               "benchmark's) or wires (form-found with the model's wires: the contact wire hangs exactly at its design "
               "height)", choices=DROPPER_STATICS),
     PANTOGRAPH_PARAMETER,
-] + NUMERICAL_PARAMETERS
+] + NUMERICAL_PARAMETERS + DEVIATION_PARAMETERS
 
 
 def design_from(p: dict):
@@ -129,6 +136,7 @@ def run(p: dict):
     if not speed < design.wave_speed:
         raise ParameterError(f"speed_kmh={p['speed_kmh']:g} km/h: must be below the contact-wire wave speed "
                              f"{design.wave_speed * 3.6:.1f} km/h")
+    form, as_built = as_built_form(design, p, p["elements_per_span"], p["element"], p["progress"])  # deviations
     base = benchmark2015_pantograph(p["speed_kmh"])
     damping = comma_numbers(p["pantograph_damping_N_s_m"], "pantograph_damping_N_s_m", 3)
     uplift = base.uplift if p["uplift_N"] < 0 else p["uplift_N"]
@@ -142,10 +150,11 @@ def run(p: dict):
                  "wave_speed_kmh": design.wave_speed * 3.6}
         return run_scene_pantograph(design, p, speed, float(panto.static_force(speed).sum()), "benchmark2015", extra,
                                     aero_force=float(panto.aero_coefficient * speed**2), lumped=panto)
-    result = run_passage(design, [panto] * p["n_pantographs"], speed, spacing=p["spacing_m"], **numerical_options(p))
+    result = run_passage(design, [panto] * p["n_pantographs"], speed, spacing=p["spacing_m"], form=form,
+                         **numerical_options(p))
     extra = {"speed_kmh": p["speed_kmh"], "uplift_N": uplift, "n_spans": design.line_spans,
              "tension_sections": design.n_sections,
-             "wave_speed_kmh": design.wave_speed * 3.6}
+             "wave_speed_kmh": design.wave_speed * 3.6, **as_built}
     return passage_output(result, p, "benchmark2015", extra)
 
 

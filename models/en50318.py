@@ -29,10 +29,17 @@ multibody path, :mod:`symcat.interaction.scene_passage`; penalty or, the wire be
 bilateral contact): its plunger uplift is trimmed so that the static contact force is
 ``static_force_N``, and the summary reports that uplift (``uplift_N``). It is not the standard's
 reference pantograph: the standard's ranges are meant for the lumped one.
+
+As built: ``dropper_length_sd_m``, ``support_height_sd_m``, ``contact_wire_irregularity_m`` (with
+``irregularity_correlation_m``) and ``deviation_seed`` build the form-found line with sampled
+errors (:mod:`symcat.catenary.deviations`; lumped pantograph); the summary then adds the realized
+static height deviation ``as_built_height_rms_m``. ``symcat study ... --samples N --seed S`` draws
+one ``deviation_seed`` per sample.
 """
 from __future__ import annotations
 
 from symcat.catenary import en50318
+from symcat.catenary.deviations import DEVIATION_PARAMETERS, as_built_form
 from symcat.errors import ParameterError
 from symcat.interaction.model_support import (
     NUMERICAL_PARAMETERS,
@@ -56,7 +63,7 @@ PARAMETERS = [
               "maximum, and the statistics are sensitive to it", minimum=0.0,
               maximum=200.0),
     PANTOGRAPH_PARAMETER,
-] + NUMERICAL_PARAMETERS
+] + NUMERICAL_PARAMETERS + DEVIATION_PARAMETERS
 
 
 def run(p: dict):
@@ -65,6 +72,7 @@ def run(p: dict):
     if not speed < design.wave_speed:
         raise ParameterError(f"speed_kmh={p['speed_kmh']:g} km/h: must be below the contact-wire wave speed "
                              f"{design.wave_speed * 3.6:.1f} km/h")
+    form, as_built = as_built_form(design, p, p["elements_per_span"], p["element"], p["progress"])  # deviations
     if p["pantograph"] != "lumped":  # a multibody pantograph pressing with static_force_N
         check_scene_pantograph(p, design.stagger)
         extra = {"speed_kmh": p["speed_kmh"], "static_force_N": p["static_force_N"],
@@ -72,9 +80,9 @@ def run(p: dict):
         return run_scene_pantograph(design, p, speed, p["static_force_N"], "en50318", extra,
                                     lumped=en50318_pantograph(p["static_force_N"]))
     panto = en50318_pantograph(p["static_force_N"])
-    result = run_passage(design, [panto], speed, **numerical_options(p))
+    result = run_passage(design, [panto], speed, form=form, **numerical_options(p))
     extra = {"speed_kmh": p["speed_kmh"], "static_force_N": p["static_force_N"],
-             "wave_speed_kmh": design.wave_speed * 3.6, "choices": design.sources}
+             "wave_speed_kmh": design.wave_speed * 3.6, "choices": design.sources, **as_built}
     return passage_output(result, p, "en50318", extra)
 
 

@@ -5,3 +5,13 @@ Layers follow the data: ``scene`` (what the user describes) -> ``symbolic`` (Sym
 ``analysis`` (statics, modes) -> ``results``.
 """
 __version__ = "0.1.0"
+
+
+def __getattr__(name):
+    """``symcat.study(...)``: the study package, callable (imported on first use, so that
+    ``import symcat`` stays light)."""
+    if name == "study":
+        import importlib
+
+        return importlib.import_module(".study", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
