@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
 
-.PHONY: install generate check-generated compile test bench demo clean
+.PHONY: install generate check-generated compile test bench demo docs clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -31,10 +31,18 @@ test: install compile
 bench: install compile
 	$(PY) -m bench.run
 
+## The documentation (docs/_build/html/index.html): tutorials executed, warnings are errors.
+## SYMCAT_DOCS_FULL=1 runs the tutorials on larger settings.
+docs: compile
+	$(PY) -m pip install -e ".[docs]" >/dev/null
+	rm -rf docs/_build docs/tutorials_gallery
+	$(PY) -m sphinx -W --keep-going -b html docs docs/_build/html
+	@echo "make docs: open $(CURDIR)/docs/_build/html/index.html"
+
 demo: install
 	$(VENV)/bin/symcat run cantilever --out out/cantilever
 	@echo "make demo: the plot (cantilever.png), the ParaView file (cantilever.vtu) and summary.json are in $(CURDIR)/out/cantilever/"
 
 clean:
-	rm -rf out build *.egg-info .pytest_cache
+	rm -rf out build *.egg-info .pytest_cache docs/_build docs/tutorials_gallery
 	rm -rf $${SYMCAT_CACHE:-$${XDG_CACHE_HOME:-$$HOME/.cache}/symcat}

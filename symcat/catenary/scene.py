@@ -85,6 +85,8 @@ def catenary_scene(form: FormFindingResult, start: str = "static", rayleigh: str
         static catenary with ``start="static"``; :attr:`Scene.linear_wires`, which then holds
         for every ANCF body of the scene); droppers, supports and contacts stay nonlinear.
 
+    Notes
+    -----
     Element names: bodies as in the structure (``contact``, ``messenger``; ``contact_2`` ...
     with several sections), ``dropper_{i}`` (i in the order of ``structure.dropper_nodes``),
     ``steady_arm_{j}`` and ``messenger_support_{j}`` (j in the order of ``cw_supports.nodes``);

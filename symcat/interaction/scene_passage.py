@@ -107,10 +107,11 @@ NOT_COMPUTED = {
 
 class SceneRecord:
     """Histories of a :func:`run_scene_passage`, under :class:`~.recorder.PassageRecorder`'s names
-    (``p`` pantographs, leading first; ``w`` contact wires of the tension sections).
+    (``p`` pantographs, leading first; ``w`` contact wires of the tension sections). The
+    attributes are NumPy arrays, SI units in the names.
 
-    Attributes (NumPy arrays, SI units in the names)
-    ------------------------------------------------
+    Attributes
+    ----------
     t_s : (n,)
     x_contact_m, contact_force_N, penetration_m, panhead_z_m, panhead_acc_m_s2 : (n, p)
         Pan-head position along the line, contact force, penetration (minus the normal gap;
@@ -123,7 +124,7 @@ class SceneRecord:
         Energy of the whole scene at the snapshots (NaN between them).
     support_z_m : (n, n_supports)
     dropper_tension_N : (n, n_droppers)
-    snapshot_t_s : (n_snapshots,), snapshot_q : (n_snapshots, n_catenary_coordinates)
+    snapshot_t_s, snapshot_q : (n_snapshots,), (n_snapshots, n_catenary_coordinates)
     static_support_z_m : (n_supports,)
         Contact-wire heights at the supports of the static catenary without pantographs.
     uplift_N, static_contact_force_N : float

@@ -79,7 +79,7 @@ def wheelset_on_track(wheel, rail, lateral_shift_m: float = 0.0, *, x_m: float =
     x_m : float
         Position along the track (m): global ``x`` on tangent track, the chainage on a layout.
     yaw_rad : float
-        Yaw angle relative to the track tangent (rad), |yaw| < 0.1.
+        Yaw angle relative to the track tangent (rad), ``|yaw| < 0.1``.
     wheelset, track, cant_rad, track_piece_length_m
         As for :class:`~symcat.wheelrail.constraint_contact.WheelRailContact` (``track`` a
         :class:`~symcat.wheelrail.TrackCrossSection`, ``None`` or a

@@ -53,6 +53,8 @@ def load_profile(name: str, smoothing_m: float = DEFAULT_SMOOTHING_M) -> Profile
     smoothing_m : float
         RMS deviation of the smoothing spline from the points [m].
 
+    Notes
+    -----
     Profiles are cached per ``(name, smoothing_m)``: treat the returned object as read-only.
     """
     if name not in _FILES:

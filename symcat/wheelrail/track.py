@@ -85,7 +85,7 @@ class TrackLayout:
     profile_inclination_rad : float
         Inclination built into the profile data [rad] (UIC60 1:40: ``atan(1/40)``).
     gradient : float
-        Constant longitudinal gradient [m/m] (rise per plan distance), |gradient| < 0.1.
+        Constant longitudinal gradient [m/m] (rise per plan distance), ``|gradient| < 0.1``.
     cant_pivot : str
         ``"centre"`` or ``"low_rail"``: the axis the cross-section turns about.
     irregularities : Irregularities, optional
