@@ -48,6 +48,8 @@ def _escape(text: str) -> str:
 
 def _literal(value) -> str:
     text = repr(value)
+    if isinstance(value, float) and len(text) > 10:
+        text = f"{value:.6g}"
     return f"``{text}``" if text.strip() else "(empty)"
 
 
@@ -140,7 +142,7 @@ def render() -> str:
         parts.append(".. list-table:: Parameters\n   :header-rows: 1\n   :widths: 18 8 12 22 40\n\n"
                      "   * - name\n     - unit\n     - default\n     - allowed\n     - description\n")
         for p in model.parameters:
-            unit = _escape(p.unit) or "(none)"
+            unit = {"": "(none)", "-": "\\-"}.get(p.unit, _escape(p.unit))  # "-": dimensionless
             parts.append(f"   * - ``{p.name}``\n     - {unit}\n     - {_literal(p.default)}\n"
                          f"     - {_escape(p.allowed())}\n     - {_escape(p.doc)}\n")
         keys = summary_keys(path)
