@@ -34,7 +34,7 @@ every dropper and support (fewer is rounded up to it), and the cheapest line to 
 the seed's 17 m/s it is enough: on the default passage (generalized-alpha, 1 ms) 10 and 28
 elements per span give the statistics within 1 % (mean 0.05 %, standard deviation 0.7 %,
 statistical extremes 0.6 %; the raw extremes within 3 %). At line speeds raise it (the
-benchmark at 320 km/h needs about 60 for 0.5 %, README).
+benchmark at 320 km/h needs about 60 for 0.5 %, docs/user_guide/catenary.md).
 
 Integrators (:func:`symcat.simulation.integrate_model`): ``generalized_alpha`` (default;
 ``dt``, ``rho_inf``; the wheel/rail contacts' events decided between its steps) or ``idas``,
