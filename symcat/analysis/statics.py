@@ -106,17 +106,17 @@ def solve_static(
     t_start = time.perf_counter()
     free = system.dofs.free
     q = np.array(system.dofs.q0 if q0 is None else q0, dtype=float)
-    scale = _load_scale(system, q)
+    newton = _FreeNewton.of(system)
+    scale = _load_scale(system, newton, q)
     lam, step = 0.0, 1.0 / max(1, int(load_steps))
     total_iterations, accepted, history = 0, 0, []
     bar = Progress("statics", total=1.0, unit="load", enabled=progress)
-    newton = _FreeNewton.of(system) if free.size else None
 
     # Step from the initial state straight towards the first load level: a slack cable has no
     # equilibrium without its load, so lambda = 0 itself is not solved first.
     while lam < 1.0:
         target = min(1.0, lam + step)
-        if newton is None:
+        if not free.size:
             ok, q_try, its, reason = True, q, 0, ""
         else:
             ok, q_try, its, reason = _plain_newton(newton, q, target, scale, rtol, max_iterations)
@@ -148,9 +148,9 @@ def solve_static(
     return StaticResult(q, 1.0, accepted, total_iterations, float(r), time.perf_counter() - t_start, True, history)
 
 
-def _load_scale(system: System, q: np.ndarray) -> float:
+def _load_scale(system: System, newton: "_FreeNewton", q: np.ndarray) -> float:
     f_ext = system.external_force_value(q)
-    r0, _ = system.eval_static(q, 0.0)
+    r0 = newton.full_residual(q, 0.0)
     return max(np.abs(f_ext).max(initial=0.0), np.abs(r0).max(initial=0.0), 1.0)
 
 
@@ -158,7 +158,7 @@ class _FreeNewton:
     """The static residual and tangent on the free coordinates, compiled as one function, and
     the linear solve of a Newton step.
 
-    ``(x, q_fixed, load_factor) -> (R_f, J_ff)`` is a CasADi function of the free coordinates
+    ``(x, q_fixed, load_factor) -> (R_f, J_ff, R)`` is a CasADi function of the free coordinates
     ``x`` (the fixed ones and the load factor as parameters) around :attr:`System.static_functions`,
     evaluated into NumPy buffers. The tangent's nonzeros go into LAPACK band storage through a
     precomputed index (reverse Cuthill-McKee order) and are factorized by ``dgbsv``; when the
@@ -190,8 +190,9 @@ class _FreeNewton:
         q = ca.mtimes(select_free, x) + ca.mtimes(select_fixed, q_fixed)
         residual, jacobian = system.static_functions(q, lam)
         rows = free.tolist()
-        fn = ca.Function("static_free", [x, q_fixed, lam], [ca.densify(residual[rows]), jacobian[rows, rows]],
-                         ["x", "q_fixed", "load_factor"], ["residual", "jacobian"])
+        fn = ca.Function("static_free", [x, q_fixed, lam],
+                         [ca.densify(residual[rows]), jacobian[rows, rows], ca.densify(residual)],
+                         ["x", "q_fixed", "load_factor"], ["residual", "jacobian", "full_residual"])
         self._fn = BufferedFunction(fn)
         colind, row = fn.sparsity_out(1).get_ccs()
         colind, row = np.array(colind, int), np.array(row, int)
@@ -215,10 +216,14 @@ class _FreeNewton:
 
     def evaluate(self, q: np.ndarray, load_factor: float) -> tuple[np.ndarray, np.ndarray]:
         """Free residual and the tangent's nonzeros (CasADi's column-major order) at ``q``."""
-        return self._fn.nonzeros(q[self.free], q[self.fixed], load_factor)
+        return self._fn.nonzeros(q[self.free], q[self.fixed], load_factor)[:2]
 
     def residual(self, q: np.ndarray, load_factor: float) -> np.ndarray:
         return self.evaluate(q, load_factor)[0]
+
+    def full_residual(self, q: np.ndarray, load_factor: float) -> np.ndarray:
+        """Residual on every coordinate (minus the reactions on the fixed ones)."""
+        return self._fn.nonzeros(q[self.free], q[self.fixed], load_factor)[2]
 
     def solve(self, jac_nz: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
         """``J_ff^-1 rhs`` (None if the tangent is singular)."""
