@@ -1,0 +1,109 @@
+"""Timing, work-precision curves and the ratio of two codes' times at equal error."""
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+
+@dataclass
+class Point:
+    """One run of one code: its setting, error against its own reference and wall times (s)."""
+
+    code: str
+    label: str
+    error: float
+    walls: list = field(default_factory=list)
+    info: str = ""
+
+    @property
+    def wall(self) -> float:
+        return float(np.median(self.walls))
+
+
+def timed(fn, *args, **kwargs):
+    """``(result, wall_s)`` of one call."""
+    t = time.perf_counter()
+    out = fn(*args, **kwargs)
+    return out, time.perf_counter() - t
+
+
+def interleaved(runs: dict, repeats: int) -> dict:
+    """Run every ``name -> callable`` ``repeats`` times, alternating the callables, and
+    return ``name -> (last result, [walls])``: the two codes see the same machine load."""
+    out = {name: (None, []) for name in runs}
+    for _ in range(repeats):
+        for name, fn in runs.items():
+            result, wall = timed(fn)
+            out[name] = (result, out[name][1] + [wall])
+    return out
+
+
+def pareto(points: list[Point]) -> np.ndarray:
+    """``(wall, error)`` rows of the points no other point beats in both, by increasing wall."""
+    pts = sorted(((p.wall, max(p.error, 1e-300)) for p in points if np.isfinite(p.error)))
+    front, best = [], np.inf
+    for w, e in pts:
+        if e < best:
+            front.append((w, e))
+            best = e
+    return np.array(front).reshape(-1, 2)
+
+
+def wall_at_error(front: np.ndarray, error: float) -> float:
+    """Wall time of a curve at ``error``, interpolated in log-log (NaN outside its range)."""
+    if front.size == 0:
+        return np.nan
+    w, e = np.log(front[:, 0]), np.log(front[:, 1])
+    le = np.log(error)
+    if le > e.max() + 1e-12 or le < e.min() - 1e-12:
+        return np.nan
+    order = np.argsort(e)
+    return float(np.exp(np.interp(le, e[order], w[order])))
+
+
+def ratios(sym: list[Point], exu: list[Point]) -> list[tuple[float, float, float, float]]:
+    """``(error, symcat wall, Exudyn wall, ratio)`` at the errors of both codes' points that lie
+    in the overlap of the two curves' error ranges."""
+    fs, fe = pareto(sym), pareto(exu)
+    if fs.size == 0 or fe.size == 0:
+        return []
+    errors = sorted(set(fs[:, 1]) | set(fe[:, 1]), reverse=True)
+    rows = []
+    for e in errors:
+        ws, we = wall_at_error(fs, e), wall_at_error(fe, e)
+        if np.isfinite(ws) and np.isfinite(we):
+            rows.append((e, ws, we, ws / we))
+    return rows
+
+
+def plot(path, title: str, curves: dict, xlabel="wall time [s]", ylabel="error [m]"):
+    """Work-precision figure: ``label -> list of Point`` on log-log axes, one PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    styles = {"symcat": "o-", "Exudyn": "s--"}
+    for label, points in curves.items():
+        pts = sorted((p.wall, max(p.error, 1e-16)) for p in points if np.isfinite(p.error))
+        if not pts:
+            continue
+        pts = np.array(pts)
+        style = next((s for k, s in styles.items() if label.startswith(k)), "^-")
+        ax.loglog(pts[:, 0], pts[:, 1], style, label=label)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
