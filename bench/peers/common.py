@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("SYMCAT_OPTIMIZE", "now")  # any compiled model DAE at its optimized tier, as `make bench`
 
 
 @dataclass
@@ -23,6 +24,14 @@ class Point:
     @property
     def wall(self) -> float:
         return float(np.median(self.walls))
+
+
+def outputs(res, n_out: int) -> np.ndarray:
+    """``res.q`` of a symcat run, checked to be on the bench's output grid of ``n_out``
+    intervals (generalized-alpha gives at most one output per step)."""
+    if len(res.t_s) != n_out + 1:
+        raise ValueError(f"{len(res.t_s)} outputs, not {n_out + 1}: use a step that divides the output interval")
+    return np.asarray(res.q)
 
 
 def timed(fn, *args, **kwargs):
@@ -72,7 +81,10 @@ def ratios(sym: list[Point], exu: list[Point]) -> list[tuple[float, float, float
     fs, fe = pareto(sym), pareto(exu)
     if fs.size == 0 or fe.size == 0:
         return []
-    errors = sorted(set(fs[:, 1]) | set(fe[:, 1]), reverse=True)
+    errors = []
+    for e in sorted(set(fs[:, 1]) | set(fe[:, 1]), reverse=True):
+        if not errors or e < 0.95 * errors[-1]:  # one row for points of (nearly) equal error
+            errors.append(e)
     rows = []
     for e in errors:
         ws, we = wall_at_error(fs, e), wall_at_error(fe, e)
@@ -84,6 +96,7 @@ def ratios(sym: list[Point], exu: list[Point]) -> list[tuple[float, float, float
 def plot(path, title: str, curves: dict, xlabel="wall time [s]", ylabel="error [m]"):
     """Work-precision figure: ``label -> list of Point`` on log-log axes, one PNG."""
     import matplotlib
+    import matplotlib.ticker
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -97,9 +110,12 @@ def plot(path, title: str, curves: dict, xlabel="wall time [s]", ylabel="error [
         pts = np.array(pts)
         style = next((s for k, s in styles.items() if label.startswith(k)), "^-")
         ax.loglog(pts[:, 0], pts[:, 1], style, label=label)
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=10)
+    import textwrap
+
+    ax.set_title("\n".join(textwrap.wrap(title, 70)), fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()

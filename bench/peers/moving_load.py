@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .common import outputs
+
 L, T, MU, EI, EA, FORCE = 60.0, 20e3, 1.35, 195.0, 1.8e7, 100.0
 SPEED = 0.5 * np.sqrt(T / MU)
 T_END = L / SPEED
@@ -63,7 +65,7 @@ def symcat_run(setting: dict, n_elements=N_ELEMENTS) -> np.ndarray:
     else:
         res = generalized_alpha(model, T_END, setting["dt"], rho_inf=setting.get("rho", 1.0), n_out=N_OUT,
                                 progress=False, tol=setting.get("tol", 1e-10))
-    return np.asarray(res.q)[:, mid]
+    return outputs(res, N_OUT)[:, mid]
 
 
 def exudyn_run(setting: dict, n_elements=N_ELEMENTS) -> np.ndarray:
@@ -129,6 +131,6 @@ def _steps(k):
 
 SYMCAT_IDAS = [{"rtol": r} for r in (1e-4, 1e-5, 1e-6)]
 SYMCAT_ALPHA = [{"dt": _steps(k), "tol": 1e-8} for k in (1, 2, 4, 8)]
-EXUDYN = [{"dt": _steps(k)} for k in (1, 2, 4, 8, 16)]
+EXUDYN = [{"dt": _steps(k)} for k in (1, 2, 4, 8, 16, 32)]
 SYMCAT_REFERENCE = {"dt": _steps(64), "tol": 1e-12}
 EXUDYN_REFERENCE = {"dt": _steps(64), "newton_rtol": 1e-10}
