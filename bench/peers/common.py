@@ -81,15 +81,11 @@ def ratios(sym: list[Point], exu: list[Point]) -> list[tuple[float, float, float
     fs, fe = pareto(sym), pareto(exu)
     if fs.size == 0 or fe.size == 0:
         return []
-    errors = []
-    for e in sorted(set(fs[:, 1]) | set(fe[:, 1]), reverse=True):
-        if not errors or e < 0.95 * errors[-1]:  # one row for points of (nearly) equal error
-            errors.append(e)
     rows = []
-    for e in errors:
+    for e in sorted(set(fs[:, 1]) | set(fe[:, 1]), reverse=True):
         ws, we = wall_at_error(fs, e), wall_at_error(fe, e)
-        if np.isfinite(ws) and np.isfinite(we):
-            rows.append((e, ws, we, ws / we))
+        if np.isfinite(ws) and np.isfinite(we) and (not rows or e < 0.95 * rows[-1][0]):
+            rows.append((e, ws, we, ws / we))  # one row for points of (nearly) equal error
     return rows
 
 

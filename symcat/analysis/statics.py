@@ -158,9 +158,9 @@ class _FreeNewton:
     """The static residual and tangent on the free coordinates, compiled as one function, and
     the linear solve of a Newton step.
 
-    ``(x, q_fixed, load_factor) -> (R_f, J_ff, R)`` is a CasADi function of the free coordinates
-    ``x`` (the fixed ones and the load factor as parameters) around :attr:`System.static_functions`,
-    evaluated into NumPy buffers. The tangent's nonzeros go into LAPACK band storage through a
+    ``(q, load_factor) -> (R_f, J_ff, R)``, the free rows (and columns) of
+    :attr:`System.static_functions` and the whole residual, is one CasADi function evaluated into
+    NumPy buffers. The tangent's nonzeros go into LAPACK band storage through a
     precomputed index (reverse Cuthill-McKee order) and are factorized by ``dgbsv``; when the
     reordered tangent is not banded enough, SuperLU factorizes it in CSC form instead.
     Built once per system (and set of free coordinates) and reused by later solves.
@@ -180,19 +180,14 @@ class _FreeNewton:
     def __init__(self, system: System, free: np.ndarray):
         n = system.n
         self.free = free
-        self.fixed = np.setdiff1d(np.arange(n), free)
-        nf, nx = free.size, self.fixed.size
-        x = ca.MX.sym("x", nf)
-        q_fixed = ca.MX.sym("q_fixed", nx)
+        nf = free.size
+        q = ca.MX.sym("q", n)
         lam = ca.MX.sym("load_factor")
-        select_free = ca.DM(ca.Sparsity.triplet(n, nf, free.tolist(), list(range(nf))), 1.0)
-        select_fixed = ca.DM(ca.Sparsity.triplet(n, nx, self.fixed.tolist(), list(range(nx))), 1.0)
-        q = ca.mtimes(select_free, x) + ca.mtimes(select_fixed, q_fixed)
         residual, jacobian = system.static_functions(q, lam)
         rows = free.tolist()
-        fn = ca.Function("static_free", [x, q_fixed, lam],
+        fn = ca.Function("static_free", [q, lam],
                          [ca.densify(residual[rows]), jacobian[rows, rows], ca.densify(residual)],
-                         ["x", "q_fixed", "load_factor"], ["residual", "jacobian", "full_residual"])
+                         ["q", "load_factor"], ["residual", "jacobian", "full_residual"])
         self._fn = BufferedFunction(fn)
         colind, row = fn.sparsity_out(1).get_ccs()
         colind, row = np.array(colind, int), np.array(row, int)
@@ -216,14 +211,14 @@ class _FreeNewton:
 
     def evaluate(self, q: np.ndarray, load_factor: float) -> tuple[np.ndarray, np.ndarray]:
         """Free residual and the tangent's nonzeros (CasADi's column-major order) at ``q``."""
-        return self._fn.nonzeros(q[self.free], q[self.fixed], load_factor)[:2]
+        return self._fn.nonzeros(q, load_factor)[:2]
 
     def residual(self, q: np.ndarray, load_factor: float) -> np.ndarray:
         return self.evaluate(q, load_factor)[0]
 
     def full_residual(self, q: np.ndarray, load_factor: float) -> np.ndarray:
         """Residual on every coordinate (minus the reactions on the fixed ones)."""
-        return self._fn.nonzeros(q[self.free], q[self.fixed], load_factor)[2]
+        return self._fn.nonzeros(q, load_factor)[2]
 
     def solve(self, jac_nz: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
         """``J_ff^-1 rhs`` (None if the tangent is singular)."""
