@@ -83,6 +83,8 @@ def reference(name: str, code: str, fn, setting: dict) -> tuple[np.ndarray, floa
 
 
 def dynamic(name: str, repeats: int, quick: bool, log) -> dict:
+    """One dynamic problem: both references, then the three curves' points run interleaved
+    ``repeats`` times; returns the points, the physics match and the references' settings."""
     mod = MODULES[name]
     ref_sym, wall_rs = reference(name, "symcat", mod.symcat_run, mod.SYMCAT_REFERENCE)
     ref_exu, wall_re = reference(name, "exudyn", mod.exudyn_run, mod.EXUDYN_REFERENCE)
@@ -201,8 +203,8 @@ def write_report(results: dict, cant: dict, wall_total: float) -> Path:
         "atol = rtol / 100) and generalized-alpha (a step sweep, the same spectral radius as Exudyn's: 0.9, 1 "
         "and 0.8 for the sliding joint, moving load and pendulum; Newton tolerance 1e-8 m); Exudyn runs "
         "generalized-alpha (Newton relative tolerance 1e-8). The references: each code's generalized-alpha "
-        "at 1/20 or less of the finest swept step, Newton tolerance 1e-12 m (symcat) or relative 1e-10 "
-        "(Exudyn). \"symcat best\" is the lower envelope of symcat's two curves (a user picks the integrator).",
+        "at the same small step (given per problem; 2 to 20 times below the finest swept step), Newton "
+        "tolerance 1e-12 m (symcat) or relative 1e-10 (Exudyn). \"symcat best\" is the lower envelope of symcat's two curves (a user picks the integrator).",
         "",
         "## Summary: symcat time / Exudyn time at equal error",
         "",
