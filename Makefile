@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
 
-.PHONY: install generate check-generated compile test bench demo clean
+.PHONY: install generate check-generated compile test bench bench-peers demo clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -30,6 +30,13 @@ test: install compile
 
 bench: install compile
 	$(PY) -m bench.run
+
+## symcat beside Exudyn on four problems (bench/report/peers.md). Exudyn is a bench-only
+## dependency: installed here, into the same venv, never by `make install` or the tests.
+EXUDYN ?= exudyn==1.13.6
+bench-peers: install compile
+	$(PY) -m pip install "$(EXUDYN)"
+	OMP_NUM_THREADS=1 $(PY) -m bench.peers
 
 demo: install
 	$(VENV)/bin/symcat run cantilever --out out/cantilever
