@@ -34,6 +34,43 @@ def outputs(res, n_out: int) -> np.ndarray:
     return np.asarray(res.q)
 
 
+def symcat_solve(model, t_end: float, n_out: int, setting: dict, rho: float):
+    """``res.q`` of ``model`` over ``t_end`` (s) at ``n_out`` intervals: IDAS for ``{"rtol": ...}``
+    (atol = rtol / 100), else generalized-alpha at ``setting["dt"]`` with spectral radius
+    ``setting.get("rho", rho)`` and Newton tolerance ``setting.get("tol", 1e-10)``."""
+    from symcat.integrate import simulate
+    from symcat.integrate.generalized_alpha import generalized_alpha
+
+    if "rtol" in setting:
+        res = simulate(model, t_end, rtol=setting["rtol"], atol=setting["rtol"] * 1e-2, n_out=n_out, progress=False)
+    else:
+        res = generalized_alpha(model, t_end, setting["dt"], rho_inf=setting.get("rho", rho), n_out=n_out,
+                                progress=False, tol=setting.get("tol", 1e-10))
+    return outputs(res, n_out)
+
+
+def exudyn_solve(exu, mbs, sensor, t_end: float, n_out: int, setting: dict, rho: float,
+                 modified_newton: bool = True) -> np.ndarray:
+    """Exudyn's generalized-alpha (spectral radius ``rho``, modified Newton or not, at relative
+    tolerance ``setting.get("newton_rtol", 1e-8)``, one thread, Eigen's sparse solver) at
+    ``setting["dt"]`` over ``t_end`` (s); the sensor's stored data (time first)."""
+    mbs.Assemble()
+    s = exu.SimulationSettings()
+    s.solutionSettings.writeSolutionToFile = False
+    s.solutionSettings.sensorsWritePeriod = t_end / n_out
+    s.timeIntegration.numberOfSteps = int(round(t_end / setting["dt"]))
+    s.timeIntegration.endTime = t_end
+    s.timeIntegration.generalizedAlpha.spectralRadius = rho
+    if modified_newton:
+        s.timeIntegration.newton.useModifiedNewton = True
+    s.timeIntegration.newton.relativeTolerance = setting.get("newton_rtol", 1e-8)
+    s.timeIntegration.verboseMode = 0
+    s.parallel.numberOfThreads = 1
+    s.linearSolverType = exu.LinearSolverType.EigenSparse
+    mbs.SolveDynamic(s)
+    return np.asarray(mbs.GetSensorStoredData(sensor))
+
+
 def timed(fn, *args, **kwargs):
     """``(result, wall_s)`` of one call."""
     t = time.perf_counter()

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import outputs
+from .common import exudyn_solve, symcat_solve
 
 L, T, MU, EI, EA, FORCE = 60.0, 20e3, 1.35, 195.0, 1.8e7, 100.0
 SPEED = 0.5 * np.sqrt(T / MU)
@@ -56,16 +56,9 @@ def symcat_model(n_elements=N_ELEMENTS):
 
 def symcat_run(setting: dict, n_elements=N_ELEMENTS) -> np.ndarray:
     """Mid-span deflections (201) for ``{"rtol": ...}`` (IDAS) or ``{"dt": ..., "rho": ...}``."""
-    from symcat.integrate import simulate
-    from symcat.integrate.generalized_alpha import generalized_alpha
-
     model, mid = symcat_model(n_elements)
-    if "rtol" in setting:
-        res = simulate(model, T_END, rtol=setting["rtol"], atol=setting["rtol"] * 1e-2, n_out=N_OUT, progress=False)
-    else:
-        res = generalized_alpha(model, T_END, setting["dt"], rho_inf=setting.get("rho", 1.0), n_out=N_OUT,
-                                progress=False, tol=setting.get("tol", 1e-10))
-    return outputs(res, N_OUT)[:, mid]
+    q = symcat_solve(model, T_END, N_OUT, setting, 1.0)
+    return q[:, mid]
 
 
 def exudyn_run(setting: dict, n_elements=N_ELEMENTS) -> np.ndarray:
@@ -104,19 +97,7 @@ def exudyn_run(setting: dict, n_elements=N_ELEMENTS) -> np.ndarray:
                                        loadUserFunction=lambda mbs_, t, load, k=k, kind=kind: shape(t, k, kind)))
     sensor = mbs.AddSensor(SensorNode(nodeNumber=nodes[n_elements // 2], storeInternal=True, writeToFile=False,
                                       outputVariableType=exu.OutputVariableType.Position))
-    mbs.Assemble()
-    s = exu.SimulationSettings()
-    s.solutionSettings.writeSolutionToFile = False
-    s.solutionSettings.sensorsWritePeriod = T_END / N_OUT
-    s.timeIntegration.numberOfSteps = int(round(T_END / setting["dt"]))
-    s.timeIntegration.endTime = T_END
-    s.timeIntegration.generalizedAlpha.spectralRadius = 1.0
-    s.timeIntegration.newton.relativeTolerance = setting.get("newton_rtol", 1e-8)
-    s.timeIntegration.verboseMode = 0
-    s.parallel.numberOfThreads = 1
-    s.linearSolverType = exu.LinearSolverType.EigenSparse
-    mbs.SolveDynamic(s)
-    data = np.asarray(mbs.GetSensorStoredData(sensor))
+    data = exudyn_solve(exu, mbs, sensor, T_END, N_OUT, setting, 1.0, modified_newton=False)
     grid = np.linspace(0.0, T_END, N_OUT + 1)
     return np.array([data[np.argmin(np.abs(data[:, 0] - t)), 2] for t in grid])
 

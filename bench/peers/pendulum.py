@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import outputs
+from .common import exudyn_solve, symcat_solve
 
 L, MU, EA, EI, T_END, N_OUT = 1.0, 8e-3, 40.0, 7.9577e-5, 2.0, 200
 N_ELEMENTS = 16
@@ -42,16 +42,9 @@ def symcat_model(n_elements=N_ELEMENTS):
 
 def symcat_run(setting: dict, n_elements=N_ELEMENTS) -> np.ndarray:
     """Tip positions (201 x 3) for ``{"rtol": ...}`` (IDAS) or ``{"dt": ...}`` (generalized-alpha)."""
-    from symcat.integrate import simulate
-    from symcat.integrate.generalized_alpha import generalized_alpha
-
     model, tip = symcat_model(n_elements)
-    if "rtol" in setting:
-        res = simulate(model, T_END, rtol=setting["rtol"], atol=setting["rtol"] * 1e-2, n_out=N_OUT, progress=False)
-    else:
-        res = generalized_alpha(model, T_END, setting["dt"], rho_inf=0.8, n_out=N_OUT, progress=False,
-                                tol=setting.get("tol", 1e-10))
-    return outputs(res, N_OUT)[:, tip]
+    q = symcat_solve(model, T_END, N_OUT, setting, 0.8)
+    return q[:, tip]
 
 
 def exudyn_run(setting: dict, n_elements=N_ELEMENTS) -> np.ndarray:
@@ -71,20 +64,7 @@ def exudyn_run(setting: dict, n_elements=N_ELEMENTS) -> np.ndarray:
         mbs.SetNodeParameter(node, "initialVelocities", [0, 0, -4.0 * x, 0, 0, 0])
     sensor = mbs.AddSensor(SensorNode(nodeNumber=nodes[-1], storeInternal=True, writeToFile=False,
                                       outputVariableType=exu.OutputVariableType.Position))
-    mbs.Assemble()
-    s = exu.SimulationSettings()
-    s.solutionSettings.writeSolutionToFile = False
-    s.solutionSettings.sensorsWritePeriod = T_END / N_OUT
-    s.timeIntegration.numberOfSteps = int(round(T_END / setting["dt"]))
-    s.timeIntegration.endTime = T_END
-    s.timeIntegration.generalizedAlpha.spectralRadius = 0.8
-    s.timeIntegration.newton.useModifiedNewton = True
-    s.timeIntegration.newton.relativeTolerance = setting.get("newton_rtol", 1e-8)
-    s.timeIntegration.verboseMode = 0
-    s.parallel.numberOfThreads = 1
-    s.linearSolverType = exu.LinearSolverType.EigenSparse
-    mbs.SolveDynamic(s)
-    data = np.asarray(mbs.GetSensorStoredData(sensor))
+    data = exudyn_solve(exu, mbs, sensor, T_END, N_OUT, setting, 0.8)
     return _on_grid(data)
 
 

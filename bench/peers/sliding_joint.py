@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import outputs
+from .common import exudyn_solve, symcat_solve
 
 L, R, EA, EI, DAMPING = 2.0, 0.01, 2.5e4, 1.0, 0.02
 MU = 7800 * np.pi * R**2
@@ -58,18 +58,11 @@ def symcat_model(n_elements=N_ELEMENTS, window=16):
 def symcat_run(setting: dict, n_elements=N_ELEMENTS) -> np.ndarray:
     """Attachment-point positions (201 x 3) for ``{"rtol": ...}`` (IDAS) or ``{"dt": ...}``
     (generalized-alpha, spectral radius 0.9 as Exudyn's)."""
-    from symcat.integrate import simulate
-    from symcat.integrate.generalized_alpha import generalized_alpha
     from symcat.scene.rigid import rotation_matrix
 
     model = symcat_model(n_elements, setting.get("window", 16))
-    if "rtol" in setting:
-        res = simulate(model, T_END, rtol=setting["rtol"], atol=setting["rtol"] * 1e-2, n_out=N_OUT, progress=False)
-    else:
-        res = generalized_alpha(model, T_END, setting["dt"], rho_inf=setting.get("rho", 0.9), n_out=N_OUT,
-                                progress=False, tol=setting.get("tol", 1e-10))
+    q = symcat_solve(model, T_END, N_OUT, setting, 0.9)
     off = model.rigid_offset["body"]
-    q = outputs(res, N_OUT)
     return np.array([row[off:off + 3] + rotation_matrix(row[off + 3:off + 7]) @ ATTACH for row in q])
 
 
@@ -102,20 +95,7 @@ def exudyn_run(setting: dict, n_elements=N_ELEMENTS) -> np.ndarray:
                                      nodeNumber=data))
     sensor = mbs.AddSensor(SensorBody(bodyNumber=body, localPosition=list(ATTACH), storeInternal=True,
                                       writeToFile=False, outputVariableType=exu.OutputVariableType.Position))
-    mbs.Assemble()
-    s = exu.SimulationSettings()
-    s.solutionSettings.writeSolutionToFile = False
-    s.solutionSettings.sensorsWritePeriod = T_END / N_OUT
-    s.timeIntegration.numberOfSteps = int(round(T_END / setting["dt"]))
-    s.timeIntegration.endTime = T_END
-    s.timeIntegration.generalizedAlpha.spectralRadius = 0.9
-    s.timeIntegration.newton.useModifiedNewton = True
-    s.timeIntegration.newton.relativeTolerance = setting.get("newton_rtol", 1e-8)
-    s.timeIntegration.verboseMode = 0
-    s.parallel.numberOfThreads = 1
-    s.linearSolverType = exu.LinearSolverType.EigenSparse
-    mbs.SolveDynamic(s)
-    out = np.asarray(mbs.GetSensorStoredData(sensor))
+    out = exudyn_solve(exu, mbs, sensor, T_END, N_OUT, setting, 0.9)
     grid = np.linspace(0.0, T_END, N_OUT + 1)
     return np.array([out[np.argmin(np.abs(out[:, 0] - t)), 1:4] for t in grid])
 
