@@ -136,6 +136,10 @@ def run(p: dict):
     if not speed < design.wave_speed:
         raise ParameterError(f"speed_kmh={p['speed_kmh']:g} km/h: must be below the contact-wire wave speed "
                              f"{design.wave_speed * 3.6:.1f} km/h")
+    if p["pantograph"] == "lumped" and p["contact"] == "bilateral":
+        # the interaction path's sliding contact goes unstable on fine meshes (60 elements per span at
+        # 1 ms: 1e5 N within 0.05 s); the lumped pantograph's bilateral contact runs on the multibody path
+        p = {**p, "pantograph": "lumped_scene"}
     form, as_built = as_built_form(design, p, p["elements_per_span"], p["element"], p["progress"])  # deviations
     base = benchmark2015_pantograph(p["speed_kmh"])
     damping = comma_numbers(p["pantograph_damping_N_s_m"], "pantograph_damping_N_s_m", 3)

@@ -109,7 +109,8 @@ PANTOGRAPH_PARAMETER = Parameter(
     "pantograph", "lumped", "", "pantograph model: lumped (the model's lumped-mass pantograph on the interaction "
     "path), lumped_scene (the same pantograph as scene bodies on the shared multibody path) or seo2005 (the seed "
     "paper's four-body pantograph as scene bodies); on the multibody path the uplift is trimmed to the static contact "
-    "force, overlaps need contact=penalty",
+    "force, overlaps need contact=penalty; lumped with contact=bilateral runs as lumped_scene (the interaction "
+    "path's bilateral contact is unstable on the default mesh)",
     choices=PANTOGRAPH_CHOICES)
 
 
