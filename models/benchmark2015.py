@@ -151,9 +151,9 @@ def run(p: dict):
                                {} if p["pantograph"] == "lumped_scene" else
                                {"pantograph_damping_N_s_m": (p["pantograph_damping_N_s_m"], "0,0,0")})
         extra = {"speed_kmh": p["speed_kmh"], "n_spans": design.line_spans, "tension_sections": design.n_sections,
-                 "wave_speed_kmh": design.wave_speed * 3.6}
+                 "wave_speed_kmh": design.wave_speed * 3.6, **as_built}
         return run_scene_pantograph(design, p, speed, float(panto.static_force(speed).sum()), "benchmark2015", extra,
-                                    aero_force=float(panto.aero_coefficient * speed**2), lumped=panto)
+                                    aero_force=float(panto.aero_coefficient * speed**2), lumped=panto, form=form)
     result = run_passage(design, [panto] * p["n_pantographs"], speed, spacing=p["spacing_m"], form=form,
                          **numerical_options(p))
     extra = {"speed_kmh": p["speed_kmh"], "uplift_N": uplift, "n_spans": design.line_spans,

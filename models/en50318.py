@@ -80,9 +80,9 @@ def run(p: dict):
     if p["pantograph"] != "lumped":  # a multibody pantograph pressing with static_force_N
         check_scene_pantograph(p, design.stagger)
         extra = {"speed_kmh": p["speed_kmh"], "static_force_N": p["static_force_N"],
-                 "wave_speed_kmh": design.wave_speed * 3.6, "choices": design.sources}
+                 "wave_speed_kmh": design.wave_speed * 3.6, "choices": design.sources, **as_built}
         return run_scene_pantograph(design, p, speed, p["static_force_N"], "en50318", extra,
-                                    lumped=en50318_pantograph(p["static_force_N"]))
+                                    lumped=en50318_pantograph(p["static_force_N"]), form=form)
     panto = en50318_pantograph(p["static_force_N"])
     result = run_passage(design, [panto], speed, form=form, **numerical_options(p))
     extra = {"speed_kmh": p["speed_kmh"], "static_force_N": p["static_force_N"],
