@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
 
-.PHONY: install generate check-generated compile test bench demo docs clean
+.PHONY: install generate check-generated compile test bench bench-peers demo docs clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -38,6 +38,13 @@ docs: compile
 	rm -rf docs/_build docs/tutorials_gallery
 	$(PY) -m sphinx -W --keep-going -b html docs docs/_build/html
 	@echo "make docs: open $(CURDIR)/docs/_build/html/index.html"
+
+## symcat beside Exudyn on four problems (bench/report/peers.md). Exudyn is a bench-only
+## dependency: installed here, into the same venv, never by `make install` or the tests.
+EXUDYN ?= exudyn==1.13.6
+bench-peers: install compile
+	$(PY) -m pip install "$(EXUDYN)"
+	OMP_NUM_THREADS=1 $(PY) -m bench.peers
 
 demo: install
 	$(VENV)/bin/symcat run cantilever --out out/cantilever

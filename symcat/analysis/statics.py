@@ -2,18 +2,30 @@
 
 Solves ``f_int(q) + lambda f_ext(q) = 0`` on the free coordinates for ``lambda`` from 0 to 1
 (internal forces include prestrain, so a pretensioned wire is loaded from the start). Each
-load step is a damped Newton iteration with the compiled sparse tangent; a step that fails is
-halved, one that converges quickly lets the next grow.
+load step first tries a plain (undamped) Newton iteration, and if that fails a damped one
+with a line search; a step that fails both is halved, one that converges quickly lets the
+next grow.
+
+An iteration costs one call of a compiled function of the free coordinates (the free residual
+and the free block of the tangent, :class:`_FreeNewton`) and one sparse LU solve: a banded
+LAPACK factorization in a bandwidth-reducing order when the tangent is banded (wires, beams),
+SuperLU otherwise. There is no Python work per element or per nonzero.
 """
 from __future__ import annotations
 
 import time
+import weakref
 from dataclasses import dataclass, field
 
+import casadi as ca
 import numpy as np
+import scipy.linalg.lapack as lapack
+import scipy.sparse as sps
 import scipy.sparse.linalg as spla
+from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ..assembly.system import System
+from ..codegen.library import BufferedFunction
 from ..errors import SolverError
 from ..progress import Progress
 
@@ -72,12 +84,15 @@ def solve_static(
     q0 : ndarray, optional
         Starting guess (default: the scene's initial coordinates).
     load_steps : int
-        Initial number of equal load increments (the stepping adapts from there).
+        Initial number of equal load increments (the stepping adapts from there). With the
+        default 1 the full load is tried in one step: plain Newton first, then damped Newton;
+        the load is split only if both fail.
     rtol : float
         Convergence when the free residual's max-norm is below ``rtol`` times the load scale,
         or when a full Newton step changes no coordinate by more than 1e-10 (relative).
     max_iterations : int
-        Newton iterations allowed per load step before the step is halved.
+        Newton iterations allowed per load step and method (plain, then damped) before the
+        step is halved.
     min_step : float
         Smallest load increment before giving up.
     progress : bool
@@ -91,7 +106,8 @@ def solve_static(
     t_start = time.perf_counter()
     free = system.dofs.free
     q = np.array(system.dofs.q0 if q0 is None else q0, dtype=float)
-    scale = _load_scale(system, q)
+    newton = _FreeNewton.of(system)
+    scale = _load_scale(system, newton, q)
     lam, step = 0.0, 1.0 / max(1, int(load_steps))
     total_iterations, accepted, history = 0, 0, []
     bar = Progress("statics", total=1.0, unit="load", enabled=progress)
@@ -100,7 +116,13 @@ def solve_static(
     # equilibrium without its load, so lambda = 0 itself is not solved first.
     while lam < 1.0:
         target = min(1.0, lam + step)
-        ok, q_try, its, reason = _newton(system, q, target, free, scale, rtol, max_iterations)
+        if not free.size:
+            ok, q_try, its, reason = True, q, 0, ""
+        else:
+            ok, q_try, its, reason = _plain_newton(newton, q, target, scale, rtol, max_iterations)
+            if not ok:
+                ok, q_try, its_damped, reason = _newton(newton, q, target, scale, rtol, max_iterations)
+                its += its_damped
         total_iterations += its
         if ok:
             q, lam = q_try, target
@@ -113,7 +135,7 @@ def solve_static(
             step /= 2
             if step < min_step:
                 bar.close()
-                res = np.abs(system.eval_static(q, lam)[0][free]).max()
+                res = np.abs(newton.residual(q, lam)).max()
                 partial = StaticResult(q, lam, accepted, total_iterations, res, time.perf_counter() - t_start, False, history)
                 raise SolverError(
                     f"static solve stopped at load factor {lam:.4g} of 1: {reason}; the load increment fell "
@@ -122,23 +144,143 @@ def solve_static(
                     partial,
                 )
     bar.close()
-    r = np.abs(system.eval_static(q, 1.0)[0][free]).max() if free.size else 0.0
+    r = np.abs(newton.residual(q, 1.0)).max() if free.size else 0.0
     return StaticResult(q, 1.0, accepted, total_iterations, float(r), time.perf_counter() - t_start, True, history)
 
 
-def _load_scale(system: System, q: np.ndarray) -> float:
+def _load_scale(system: System, newton: "_FreeNewton", q: np.ndarray) -> float:
     f_ext = system.external_force_value(q)
-    r0, _ = system.eval_static(q, 0.0)
+    r0 = newton.full_residual(q, 0.0)
     return max(np.abs(f_ext).max(initial=0.0), np.abs(r0).max(initial=0.0), 1.0)
 
 
-def _line_search(system, q, dq, free, lam, s0, max_trials=5):
+class _FreeNewton:
+    """The static residual and tangent on the free coordinates, compiled as one function, and
+    the linear solve of a Newton step.
+
+    ``(q, load_factor) -> (R_f, J_ff, R)``, the free rows (and columns) of
+    :attr:`System.static_functions` and the whole residual, is one CasADi function evaluated into
+    NumPy buffers. The tangent's nonzeros go into LAPACK band storage through a
+    precomputed index (reverse Cuthill-McKee order) and are factorized by ``dgbsv``; when the
+    reordered tangent is not banded enough, SuperLU factorizes it in CSC form instead.
+    Built once per system (and set of free coordinates) and reused by later solves.
+    """
+
+    _CACHE: "weakref.WeakKeyDictionary[System, dict]" = weakref.WeakKeyDictionary()
+
+    @classmethod
+    def of(cls, system: System) -> "_FreeNewton":
+        free = system.dofs.free
+        per_system = cls._CACHE.setdefault(system, {})
+        key = free.tobytes()
+        if key not in per_system:
+            per_system[key] = cls(system, free)
+        return per_system[key]
+
+    def __init__(self, system: System, free: np.ndarray):
+        n = system.n
+        self.free = free
+        nf = free.size
+        q = ca.MX.sym("q", n)
+        lam = ca.MX.sym("load_factor")
+        residual, jacobian = system.static_functions(q, lam)
+        rows = free.tolist()
+        fn = ca.Function("static_free", [q, lam],
+                         [ca.densify(residual[rows]), jacobian[rows, rows], ca.densify(residual)],
+                         ["q", "load_factor"], ["residual", "jacobian", "full_residual"])
+        self._fn = BufferedFunction(fn)
+        colind, row = fn.sparsity_out(1).get_ccs()
+        colind, row = np.array(colind, int), np.array(row, int)
+        col = np.repeat(np.arange(nf), np.diff(colind))
+        pattern = sps.csc_matrix((np.ones(row.size), row, colind), shape=(nf, nf))
+        self._csc = (row, colind, (nf, nf))
+        perm = reverse_cuthill_mckee((pattern + pattern.T).tocsr(), symmetric_mode=True) if nf else np.arange(0)
+        inverse = np.empty(nf, int)
+        inverse[perm] = np.arange(nf)
+        i, j = inverse[row], inverse[col]
+        kl = int(max((i - j).max(initial=0), 0))
+        ku = int(max((j - i).max(initial=0), 0))
+        # Band LU costs O(n kl (kl + ku)); beyond a quarter of n a general sparse LU is cheaper.
+        self.banded = nf > 0 and max(kl, ku) <= max(8, nf // 4)
+        if self.banded:
+            self._perm, self._kl, self._ku = perm, kl, ku
+            shape = (2 * kl + ku + 1, nf)
+            # LAPACK band storage (Fortran order): A[i, j] at ab[kl + ku + i - j, j].
+            self._band_index = np.ravel_multi_index((kl + ku + i - j, j), shape, order="F")
+            self._band_shape = shape
+
+    def evaluate(self, q: np.ndarray, load_factor: float) -> tuple[np.ndarray, np.ndarray]:
+        """Free residual and the tangent's nonzeros (CasADi's column-major order) at ``q``."""
+        return self._fn.nonzeros(q, load_factor)[:2]
+
+    def residual(self, q: np.ndarray, load_factor: float) -> np.ndarray:
+        return self.evaluate(q, load_factor)[0]
+
+    def full_residual(self, q: np.ndarray, load_factor: float) -> np.ndarray:
+        """Residual on every coordinate (minus the reactions on the fixed ones)."""
+        return self._fn.nonzeros(q, load_factor)[2]
+
+    def solve(self, jac_nz: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
+        """``J_ff^-1 rhs`` (None if the tangent is singular)."""
+        if self.banded:
+            ab = np.zeros(self._band_shape[0] * self._band_shape[1])
+            ab[self._band_index] = jac_nz
+            ab = ab.reshape(self._band_shape, order="F")
+            b = rhs[self._perm].copy()
+            _, _, x, info = lapack.dgbsv(self._kl, self._ku, ab, b, overwrite_ab=True, overwrite_b=True)
+            if info != 0:
+                return None
+            out = np.empty_like(x)
+            out[self._perm] = x
+            return out
+        row, colind, shape = self._csc
+        try:
+            return spla.splu(sps.csc_matrix((jac_nz, row, colind), shape=shape)).solve(rhs)
+        except RuntimeError:  # exactly singular factor
+            return None
+
+
+def _plain_newton(newton: _FreeNewton, q, lam, scale, rtol, max_iterations, xtol=1e-10):
+    """Undamped Newton iteration at a fixed load factor: fast when it converges, and it does
+    from a straight start for the cantilever or the taut wire in one load step. Fails (for the
+    damped iteration to take over) on a non-finite or singular step, or on a residual grown
+    far beyond the start's. Returns (ok, q, iterations, reason)."""
+    q = q.copy()
+    free = newton.free
+    tol = rtol * scale
+    norm0 = None
+    for it in range(1, max_iterations + 1):
+        r, jac_nz = newton.evaluate(q, lam)
+        norm = np.abs(r).max(initial=0.0)
+        if not np.isfinite(norm):
+            return False, q, it, "non-finite residual"
+        if norm <= tol:
+            return True, q, it - 1, ""
+        norm0 = norm if norm0 is None else norm0
+        if norm > 1e6 * norm0:
+            return False, q, it, f"Newton diverged (residual {norm:.3g} N)"
+        dq = newton.solve(jac_nz, -r)
+        if dq is None or not np.all(np.isfinite(dq)):
+            return False, q, it, "singular tangent (a mechanism or an unloaded slack cable?)"
+        q[free] += dq
+        if np.abs(dq).max() <= xtol * (1 + np.abs(q).max()):
+            # The correction is at round-off (see _newton).
+            return True, q, it, ""
+    r = newton.residual(q, lam)
+    if np.abs(r).max(initial=0.0) <= tol:
+        return True, q, max_iterations, ""
+    return False, q, max_iterations, f"plain Newton did not converge in {max_iterations} iterations"
+
+
+def _line_search(newton, q, dq, lam, s0, max_trials=5):
     """Step length along ``dq`` that makes the slope ``dq . R`` small (secant iterations)."""
+    free = newton.free
+
     def trial(alpha):
         q_a = q.copy()
         q_a[free] += alpha * dq
-        r_a, j_a = system.eval_static(q_a, lam)
-        return q_a, r_a, j_a, dq @ r_a[free]
+        r_a, j_a = newton.evaluate(q_a, lam)
+        return q_a, r_a, j_a, dq @ r_a
 
     best = None
     a_prev, s_prev = 0.0, s0
@@ -161,35 +303,31 @@ def _line_search(system, q, dq, free, lam, s0, max_trials=5):
     return best[0], best[1], best[2], best[3]
 
 
-def _newton(system, q, lam, free, scale, rtol, max_iterations, xtol=1e-10):
+def _newton(newton, q, lam, scale, rtol, max_iterations, xtol=1e-10):
     """Damped Newton iteration at a fixed load factor; returns (ok, q, iterations, reason)."""
     q = q.copy()
-    r, jac = system.eval_static(q, lam)
-    norm = np.abs(r[free]).max(initial=0.0)
+    r, jac = newton.evaluate(q, lam)
+    norm = np.abs(r).max(initial=0.0)
     norm0 = max(norm, rtol * scale)
     tol = rtol * scale
     for it in range(1, max_iterations + 1):
         if norm <= tol:
             return True, q, it - 1, ""
-        j_ff = jac[free][:, free]
-        try:
-            dq = spla.spsolve(j_ff.tocsc(), -r[free])
-        except RuntimeError as exc:  # singular factor
-            return False, q, it, f"singular tangent ({exc})"
-        if not np.all(np.isfinite(dq)):
+        dq = newton.solve(jac, -r)
+        if dq is None or not np.all(np.isfinite(dq)):
             return False, q, it, "singular tangent (a mechanism or an unloaded slack cable?)"
         if np.abs(dq).max() <= xtol * (1 + np.abs(q).max()):
             # The correction is at round-off: the residual of stiff wires (EA ~ 1e9 N) cannot
             # get below ~1e-16 EA, whatever the force tolerance says.
-            q[free] += dq
+            q[newton.free] += dq
             return True, q, it, ""
         # Line search on the slope s(alpha) = dq . R(q + alpha dq) of the total potential along
         # dq (Crisfield): the residual norm itself is a poor merit function for wires, where a
         # good transverse step leaves large axial residuals that the next step removes.
-        s0 = dq @ r[free]
-        q_new, r_new, jac_new, alpha = _line_search(system, q, dq, free, lam, s0)
+        s0 = dq @ r
+        q_new, r_new, jac_new, alpha = _line_search(newton, q, dq, lam, s0)
         q, r, jac = q_new, r_new, jac_new
-        norm = np.abs(r[free]).max(initial=0.0)
+        norm = np.abs(r).max(initial=0.0)
         if not np.isfinite(norm):
             return False, q, it, "non-finite residual"
         if norm > 1e8 * norm0:

@@ -207,17 +207,12 @@ def as_built_form(design: CatenaryDesign, p: dict, elements_per_span: int, eleme
     Raises
     ------
     ParameterError
-        Deviations with a multibody pantograph (``p["pantograph"]`` other than ``lumped``: that
-        path form-finds the line itself), or a dropper made too short.
+        A dropper made too short.
     """
     from .formfinding import find_form
 
     deviations = Deviations.from_params(p)
     if not deviations.any:
         return None, {}
-    if p.get("pantograph", "lumped") != "lumped":
-        name = next(k for k in ("dropper_length_sd_m", "support_height_sd_m", "contact_wire_irregularity_m") if p[k] > 0)
-        raise ParameterError(f"{name}={p[name]:g} m with pantograph={p['pantograph']}: the as-built deviations apply "
-                             "to pantograph=lumped only")
     form = find_form(design, elements_per_span, element, progress=progress)
     return build_as_built(form, deviations)

@@ -109,7 +109,8 @@ PANTOGRAPH_PARAMETER = Parameter(
     "pantograph", "lumped", "", "pantograph model: lumped (the model's lumped-mass pantograph on the interaction "
     "path), lumped_scene (the same pantograph as scene bodies on the shared multibody path) or seo2005 (the seed "
     "paper's four-body pantograph as scene bodies); on the multibody path the uplift is trimmed to the static contact "
-    "force, overlaps need contact=penalty",
+    "force, overlaps need contact=penalty; lumped with contact=bilateral runs as lumped_scene (the interaction "
+    "path's bilateral contact is unstable on the default mesh)",
     choices=PANTOGRAPH_CHOICES)
 
 
@@ -148,20 +149,23 @@ def check_scene_pantograph(p: dict, stagger: float, n_pantographs: int = 1, tens
 
 
 def run_scene_pantograph(design, p: dict, speed: float, target_force: float, stem: str, extra: dict,
-                         aero_force: float = 0.0, lumped=None) -> ModelOutput:
+                         aero_force: float = 0.0, lumped=None, form=None) -> ModelOutput:
     """Run ``p["pantograph"]`` (a multibody pantograph) over ``design`` at ``speed`` (m/s) with
     the static contact force ``target_force`` (N) by
     :func:`~.scene_passage.run_scene_passage`, with the model's numerical and contact
     parameters; summary and files as :func:`passage_output`, plus the trimmed uplift.
     ``lumped``: the model's :class:`~symcat.pantograph.LumpedPantograph` (for ``lumped_scene``;
-    its own aerodynamic force, so ``aero_force`` is for ``seo2005`` only)."""
+    its own aerodynamic force, so ``aero_force`` is for ``seo2005`` only). ``form``: the
+    form-found ``design`` to run on (an as-built one, :mod:`symcat.catenary.deviations`), else
+    form-found here."""
     from .scene_pantographs import lumped_fragment, seo2005_fragment
     from .scene_passage import run_scene_passage
 
     from ..catenary import find_form
 
     o = numerical_options(p)
-    form = find_form(design, o["elements_per_span"], o["element"], progress=o["progress"])
+    if form is None:
+        form = find_form(design, o["elements_per_span"], o["element"], progress=o["progress"])
     if p["pantograph"] == "lumped_scene":
         n = p.get("n_pantographs", 1)
         fragment = [lumped_fragment(lumped, p["contact"], p["contact_stiffness"], p["contact_damping"], form=form,

@@ -102,3 +102,60 @@ def test_wire_pulled_by_a_prescribed_end_tension():
     assert q[system.dofs.index(wire, -1, "x")] == pytest.approx(20.0 * (1 + 15e3 / ea), rel=1e-12)
     eps = system.body_set("w").lib["cable3d_strain"](q[system.dofs.element_indices(wire)[3]], 0.3, wire.params[3])[0]
     assert float(eps) * ea == pytest.approx(15e3, rel=1e-9)
+
+
+def _cantilever(element="cable2d", n=64, alpha=3.0):
+    """Clamped 2 m steel beam, square 0.1 m section, tip load alpha E I / L^2 in -y."""
+    dim = 2 if element == "cable2d" else 3
+    section = Section.rectangle(0.1, 0.1)
+    end = np.zeros(dim)
+    end[0] = 2.0
+    beam = AncfBody.straight("b", element, np.zeros(dim), end, n, Material(2.07e11, 7850.0), section)
+    beam.clamp(0)
+    force = np.zeros(dim)
+    force[1] = -alpha * 2.07e11 * section.Iz / 4.0
+    scene = Scene()
+    scene.add(beam)
+    scene.add(NodalForce("b", -1, tuple(force)))
+    return assemble(scene), beam
+
+
+@pytest.mark.parametrize("element", ["cable2d", "cable3d"])
+def test_cantilever_converges_in_one_load_step_of_plain_newton(element):
+    """The large-deflection cantilever (alpha = 3) from straight in one load step of plain
+    Newton (the damped iteration with its line search needs many more), on the extensible
+    elastica (exudyn-peers.md, problem 3)."""
+    system, beam = _cantilever(element)
+    result = solve_static(system)
+    assert result.load_steps == 1 and result.newton_iterations < 10
+    tip = result.q[system.dofs.node_indices(beam, -1)][:2]
+    np.testing.assert_allclose(tip, [2.0 - 0.5085373043, -1.2072398545], atol=1e-8)
+
+
+def test_the_damped_newton_takes_over_when_plain_newton_fails(monkeypatch):
+    statics = importlib.import_module("symcat.analysis.statics")
+    system, beam = _cantilever(n=16)
+    plain = solve_static(system).q
+    monkeypatch.setattr(statics, "_plain_newton", lambda newton, q, *args: (False, q, 1, "forced failure"))
+    damped = solve_static(system)
+    assert damped.newton_iterations > 1  # the damped iteration did the work
+    np.testing.assert_allclose(damped.q, plain, atol=1e-9)
+
+
+def test_banded_and_general_sparse_newton_steps_agree(rng):
+    """The band LU (reverse Cuthill-McKee order) and SuperLU solve the same free tangent as
+    the full system's Jacobian restricted to the free coordinates."""
+    statics = importlib.import_module("symcat.analysis.statics")
+    system, _ = _cantilever("cable3d", n=12)
+    q = system.dofs.q0 + 1e-3 * rng.standard_normal(system.n)
+    free = system.dofs.free
+    newton = statics._FreeNewton(system, free)
+    assert newton.banded
+    r, jac_nz = newton.evaluate(q, 0.7)
+    r_full, jac_full = system.eval_static(q, 0.7)
+    np.testing.assert_allclose(r, r_full[free], rtol=1e-12, atol=1e-6)
+    rhs = rng.standard_normal(free.size)
+    expected = np.linalg.solve(jac_full[free][:, free].toarray(), rhs)
+    np.testing.assert_allclose(newton.solve(jac_nz, rhs), expected, rtol=1e-8, atol=1e-14)
+    newton.banded = False
+    np.testing.assert_allclose(newton.solve(jac_nz, rhs), expected, rtol=1e-8, atol=1e-14)
