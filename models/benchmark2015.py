@@ -69,6 +69,7 @@ from symcat.interaction.model_support import (
     numerical_options,
     passage_output,
     run_scene_pantograph,
+    scene_pantograph_choice,
 )
 from symcat.interaction.passage import run_passage, spans_needed
 from symcat.model import Model, Parameter, comma_numbers, numbers_check
@@ -136,10 +137,7 @@ def run(p: dict):
     if not speed < design.wave_speed:
         raise ParameterError(f"speed_kmh={p['speed_kmh']:g} km/h: must be below the contact-wire wave speed "
                              f"{design.wave_speed * 3.6:.1f} km/h")
-    if p["pantograph"] == "lumped" and p["contact"] == "bilateral":
-        # the interaction path's sliding contact goes unstable on fine meshes (60 elements per span at
-        # 1 ms: 1e5 N within 0.05 s); the lumped pantograph's bilateral contact runs on the multibody path
-        p = {**p, "pantograph": "lumped_scene"}
+    p = scene_pantograph_choice(p)
     form, as_built = as_built_form(design, p, p["elements_per_span"], p["element"], p["progress"])  # deviations
     base = benchmark2015_pantograph(p["speed_kmh"])
     damping = comma_numbers(p["pantograph_damping_N_s_m"], "pantograph_damping_N_s_m", 3)
@@ -147,7 +145,7 @@ def run(p: dict):
     panto = LumpedPantograph(base.masses, base.stiffness, damping, uplift, base.uplift_stage,
                              aero_coefficient=p["aero_coefficient_N_s2_m2"], name=base.name, sources=base.sources)
     if p["pantograph"] != "lumped":  # a multibody pantograph with the lumped one's static contact force
-        check_scene_pantograph(p, design.stagger, p["n_pantographs"], design.n_sections,
+        check_scene_pantograph(p, design.stagger, design.n_sections,
                                {} if p["pantograph"] == "lumped_scene" else
                                {"pantograph_damping_N_s_m": (p["pantograph_damping_N_s_m"], "0,0,0")})
         extra = {"speed_kmh": p["speed_kmh"], "n_spans": design.line_spans, "tension_sections": design.n_sections,

@@ -48,6 +48,7 @@ from symcat.interaction.model_support import (
     numerical_options,
     passage_output,
     run_scene_pantograph,
+    scene_pantograph_choice,
 )
 from symcat.interaction.passage import run_passage
 from symcat.model import Model, Parameter
@@ -72,10 +73,7 @@ def run(p: dict):
     if not speed < design.wave_speed:
         raise ParameterError(f"speed_kmh={p['speed_kmh']:g} km/h: must be below the contact-wire wave speed "
                              f"{design.wave_speed * 3.6:.1f} km/h")
-    if p["pantograph"] == "lumped" and p["contact"] == "bilateral":
-        # the interaction path's sliding contact goes unstable on fine meshes (60 elements per span at
-        # 1 ms: 1e5 N within 0.05 s); the lumped pantograph's bilateral contact runs on the multibody path
-        p = {**p, "pantograph": "lumped_scene"}
+    p = scene_pantograph_choice(p)
     form, as_built = as_built_form(design, p, p["elements_per_span"], p["element"], p["progress"])  # deviations
     if p["pantograph"] != "lumped":  # a multibody pantograph pressing with static_force_N
         check_scene_pantograph(p, design.stagger)

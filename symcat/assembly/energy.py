@@ -5,8 +5,8 @@ The energy is ``E = T + V``: the kinetic energy and a potential ``V`` of every f
 here: the wires' strain energy, gravity and the constant loads (:meth:`MultibodyModel.potential_energy`),
 the springs of :class:`~symcat.scene.SpringDamper` elements (``k e^2 / 2 + k3 e^4 / 4`` of the
 stretch ``e``; tension-only ones while stretched), the constant part ``F0`` of point loads
-(``-F0 . r``) and the penalty springs of wire contacts (``k p^2 / 2`` of the penetration ``p``;
-the smoothing of the law changes it by ``O(k delta^2)``). Over a run, ``E(t) - E(0)`` equals the
+(``-F0 . r``) and the penalty springs of wire contacts (the integral of their smoothed law over
+the penetration). Over a run, ``E(t) - E(0)`` equals the
 work of the rest: the power
 
 ``P = v . (Q_e + grad V_e) - v^T C v + lambda . C_t``
@@ -24,6 +24,7 @@ import casadi as ca
 import numpy as np
 
 from ..codegen.library import BufferedFunction, kernel_library, library_interface
+from .multibody import _gather
 from .sparse import to_scipy
 
 
@@ -37,12 +38,10 @@ def _points(kind: str, y: ca.MX, u: np.ndarray) -> ca.MX:
     if kind == "node":
         return y[0:3, :] + u_dm
     e0, e = y[3, :], y[4:7, :]
-    m = u.shape[1]
     e_dot_u = ca.repmat(ca.sum1(e * u_dm), 3, 1)
     cross = ca.vertcat(e[1, :] * u_dm[2, :] - e[2, :] * u_dm[1, :], e[2, :] * u_dm[0, :] - e[0, :] * u_dm[2, :],
                        e[0, :] * u_dm[1, :] - e[1, :] * u_dm[0, :])
-    return y[0:3, :] + ca.repmat(2 * e0**2 - 1, 3, 1) * u_dm + 2 * (e * e_dot_u + ca.repmat(e0, 3, 1) * cross) \
-        if m else ca.MX(3, 0)
+    return y[0:3, :] + ca.repmat(2 * e0**2 - 1, 3, 1) * u_dm + 2 * (e * e_dot_u + ca.repmat(e0, 3, 1) * cross)
 
 
 _SIZES = {"ground": 0, "node": 3, "rigid": 7}
@@ -78,19 +77,12 @@ def _conservative(library: str, par: dict) -> np.ndarray:
     return np.zeros(m, bool)
 
 
-def penalty_law(pen: np.ndarray, k: np.ndarray, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def penalty_law(pen, k, delta) -> tuple[np.ndarray, np.ndarray]:
     """Potential (J) and force (N) of the smoothed penalty law of the contact kernels without
     damping, ``f = ramp(k ramp(p, delta), k delta)`` (:func:`symcat.codegen.multibody_kernels._ramp`),
     at the penetrations ``p`` (m): ``f = k p^4 / (8 delta^3)`` up to ``delta``,
     ``k (p - delta/2)^2 / (2 delta)`` up to ``3 delta / 2``, ``k (p - delta)`` beyond."""
-    u, d = np.asarray(pen, float), np.asarray(delta, float)
-    v_c1 = k * d**2 / 40
-    v_d1 = v_c1 + 7 * k * d**2 / 48
-    potential = np.select([u <= 0, u < d, u < 1.5 * d],
-                          [0.0, k * u**5 / (40 * d**3), v_c1 + k / (6 * d) * ((u - d / 2) ** 3 - (d / 2) ** 3)],
-                          v_d1 + k * (u - d) ** 2 / 2 - k * d**2 / 8)
-    force = np.select([u <= 0, u < d, u < 1.5 * d], [0.0, k * u**4 / (8 * d**3), k * (u - d / 2) ** 2 / (2 * d)],
-                      k * (u - d))
+    potential, force = np.vectorize(_penalty_scalar, otypes=[float, float])(pen, k, delta)
     return potential, force
 
 
@@ -151,7 +143,8 @@ class _ContactEnergy:
 
 
 def _penalty_scalar(u: float, k: float, d: float) -> tuple[float, float]:
-    """:func:`penalty_law` of one penetration (the per-step path: NumPy's overhead is the cost)."""
+    """:func:`penalty_law` of one penetration, in plain Python (the per-step path, where NumPy's
+    overhead would be the cost)."""
     if u <= 0:
         return 0.0, 0.0
     if u < d:
@@ -258,9 +251,3 @@ def balance(t: np.ndarray, driving_W: np.ndarray, other_W: np.ndarray, t_energy:
     work = float(np.sum(0.5 * (drive[1:] + drive[:-1]) * np.diff(t)))
     return {"t_s": np.asarray(t_energy), "energy_J": np.asarray(energy_J), "expected_J": expected,
             "error_J": np.asarray(energy_J) - expected, "work_scale_J": work}
-
-
-def _gather(x: ca.MX, rows: np.ndarray) -> ca.MX:
-    rows = np.asarray(rows)
-    return ca.reshape(x[rows.ravel().tolist()], rows.shape[1], rows.shape[0])
-
