@@ -95,7 +95,8 @@ def test_a_bead_crossing_element_ends_in_the_compiled_steps(record_property):
     python, compiled = _both(lambda: ring(8, window=8), 0.4, 1e-3, rho_inf=0.9, tol=1e-10)
     assert compiled.s_m[-1, 0] - compiled.s_m[0, 0] > 2.0 * np.radians(350.0) / 8  # two element ends
     assert compiled.stats["compiled_steps"] == 400
-    assert np.abs(compiled.s_m - python.s_m).max() < 1e-8
+    # both stop Newton within 1e-10 m of the step's solution; over 400 steps that adds up
+    assert np.abs(compiled.s_m - python.s_m).max() < 1e-6
 
 
 def test_steps_the_compiled_code_cannot_take_are_taken_in_python():
@@ -108,8 +109,14 @@ def test_steps_the_compiled_code_cannot_take_are_taken_in_python():
 
 
 def test_what_stays_in_python_says_why():
-    assert "windows that move" in unsupported(slider(window=2))
-    assert unsupported(slider()) is None
-    model = cable_pendulum()
-    run = generalized_alpha(model, 0.01, 1e-3, n_out=2, progress=False, compiled=False)
+    """Element windows that move, or wheel/rail contacts; and compiled=False."""
+    from types import SimpleNamespace
+
+    assert "windows that move" in unsupported(SimpleNamespace(model=slider(window=2)))
+    assert unsupported(SimpleNamespace(model=slider())) is None
+    wheels = SimpleNamespace(model=SimpleNamespace(wheelrail=[object()]))
+    assert "wheel/rail" in unsupported(wheels)
+    moving = generalized_alpha(slider(window=2), 0.01, 1e-3, n_out=2, progress=False, compiled=True)
+    assert "compiled_steps" not in moving.stats and moving.stats["steps"] == 10
+    run = generalized_alpha(cable_pendulum(), 0.01, 1e-3, n_out=2, progress=False, compiled=False)
     assert "compiled_steps" not in run.stats
