@@ -19,10 +19,11 @@ import casadi as ca
 from ..codegen.library import merged
 from .alpha_bulk import bulk_rows, step_data
 
-#: Wire coordinates up to which the wires' Jacobian is expanded to scalar operations (a third
-#: faster on a 16-element cable, whose iteration matrix is renewed most steps at coarse steps;
-#: its code grows with the elements' stiffness kernels, thousands of operations each).
-EXPANDED_JACOBIAN = 120
+#: Operations up to which the wires' Jacobian is expanded to scalar operations (a third faster
+#: on a 16-element cable, 60k operations, whose iteration matrix is renewed most steps at coarse
+#: steps); beyond, it stays a graph of the elements' stiffness kernels (the compiler's time
+#: grows with the code: damped elements' Jacobians are several times larger).
+EXPANDED_JACOBIAN = 70_000
 
 
 class ChunkResidual:
@@ -53,10 +54,20 @@ class ChunkResidual:
             for sl, window in zip(items, saved):
                 sl.window = window
         self._rest = ca.Function("alpha_chunk_rest", [y, p], [rows, shift])
+        self._rest_jacobian = None
         if expand:
             self._bulk, self._rest = merged(self._bulk.expand()), merged(self._rest.expand())
-            if n_b <= EXPANDED_JACOBIAN:
-                self._bulk_jacobian = merged(self._bulk_jacobian.expand())
+            expanded = self._bulk_jacobian.expand()
+            if expanded.n_instructions() <= EXPANDED_JACOBIAN:
+                self._bulk_jacobian = merged(expanded)
+            # The rest's border in scalar operations, differentiated where its entries depend
+            # on the unknowns: CasADi's derivative of a call in all directions would be the
+            # rest's code as many times over as there are directions.
+            y_s, p_s = self._rest.sx_in()
+            rows_s, shift_s = self._rest(y_s, p_s)
+            y_r = y_s[n_b:]
+            self._rest_jacobian = merged(ca.Function("alpha_chunk_rest_jacobian", [y_s, p_s], [
+                ca.jacobian(rows_s, y_r), ca.jacobian(rows_s[n_b:], y_s[:n_b]), ca.jacobian(shift_s[:n_b], y_r)]))
 
     # --- the step's functions -------------------------------------------------------------------
     def parts(self, y, p):
@@ -77,17 +88,20 @@ class ChunkResidual:
         a refactorization of the border only)."""
         n_b, n_u = self.n_b, self.n_u
         y = ca.vertcat(y_b, y_r)
-        rows, shift = self.parts(y, p)
-        j_cols = ca.jacobian(rows, y_r)
-        j_rows = ca.jacobian(rows[n_b:], y_b)
+        if self._rest_jacobian is not None:
+            j_cols, j_rows, d_shift = self._rest_jacobian(y, p)
+        else:
+            rows, shift = self.parts(y, p)
+            j_cols, j_rows, d_shift = (ca.jacobian(rows, y_r), ca.jacobian(rows[n_b:], y_b),
+                                       ca.jacobian(shift[:n_b], y_r))
         if not n_b:
             return j_cols
+        shift = self.parts(y, p)[1]
         j_bb = self._bulk_jacobian(y_b, p, shift[:n_b]) if wires else ca.MX(n_b, n_b)
         # the wires' rows through the stabilization's shift of their accelerations:
         # -(c_m M + gamma h C) d shift / d y_r, with the constant mass and Rayleigh matrices
         *_, gh, cm = step_data(p, n_u)
         bulk = self.st.bulk
-        d_shift = ca.jacobian(shift[:n_b], y_r)
         through_shift = -(cm * ca.mtimes(_dm(bulk.mass_matrix), d_shift) + gh * ca.mtimes(_dm(bulk.rayleigh), d_shift))
         return ca.blockcat([[j_bb, j_cols[:n_b, :] + through_shift], [j_rows, j_cols[n_b:, :]]])
 
