@@ -120,3 +120,21 @@ def test_what_stays_in_python_says_why():
     assert "compiled_steps" not in moving.stats and moving.stats["steps"] == 10
     run = generalized_alpha(cable_pendulum(), 0.01, 1e-3, n_out=2, progress=False, compiled=False)
     assert "compiled_steps" not in run.stats
+
+
+def test_compiled_steps_of_a_penalty_contact_that_opens_and_closes(record_property):
+    """A head launched down from a wire (penalty contact, damped wire): the contact's arc length
+    is an unknown of the step and its tangency a row; the contact opens and closes inside the
+    compiled calls; index-3 variant."""
+    from tests.dynamics.test_contact import head_under_wire
+
+    def make():
+        return head_under_wire(v0=-2.0)[0]
+
+    python, compiled = _both(make, 0.15, 5e-4, rho_inf=0.9, tol=1e-10, variant="index3")
+    apart = np.abs(compiled.q - python.q).max()
+    record_property("apart_m", apart)
+    assert compiled.stats["compiled_steps"] > 0.9 * compiled.stats["steps"]
+    assert apart < 1e-6
+    gap = compiled.contacts["contact"]["gap_m"]
+    assert (gap > 0).any() and (gap <= 0).any()  # it opened and closed
