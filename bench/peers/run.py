@@ -56,12 +56,11 @@ NOTES = [
     "`MultibodyModel.v0`.",
     "- **Cantilever**: identical (both against the extensible elastica).",
     "- **Compiled steps** (`symcat.integrate.alpha_chunk`): symcat's generalized-alpha runs its steps "
-    "compiled, up to 32 to a call, where the model allows it: the pendulum. The sliding joint's and the "
-    "moving load's element windows move along their wires (48 and 60 elements, windows of 16), so their "
-    "steps are still taken from Python; the compiled code would have to hold every element under the "
-    "point. symcat's runs keep the integrator's own multipliers (no KKT solve per output), as Exudyn "
-    "reports only its sensors; the compiled library of each model is built before the timed runs, as "
-    "the kernels are.",
+    "compiled, up to 32 to a call, on all three dynamic problems (the sliding joint's and the moving "
+    "load's points on one proxy element that the code fills with the element holding them). symcat's "
+    "runs keep the integrator's own multipliers (no KKT solve per output), as Exudyn reports only its "
+    "sensors; each model's compiled library is built before the timed runs, as the kernels are (20 to "
+    "60 s once per model).",
     "- **IDAS on the moving load and the pendulum**: the error does not change with rtol (1e-5 to 2e-5 m): "
     "it is the distance between IDAS's solution and symcat's generalized-alpha reference, whose numerical "
     "dissipation (spectral radius 0.8 on the pendulum) and step leave that much; the IDAS points therefore "

@@ -10,23 +10,24 @@ its convergence test) are one CasADi function of up to :data:`MAX_STEPS` steps, 
 C and compiled once per model (cached on disk like the models' DAEs,
 :func:`symcat.codegen.model_dae.compiled_library`):
 
-- the residual is :meth:`.alpha_step.StepEquations._rows` of the whole model, with the
-  sliding and contact points' element windows over their whole wires (the code must not
-  depend on where a point is), expanded to scalar operations;
-- the iteration matrix is the step's exact Jacobian, factorized in the code as a band (the
-  wires, ordered by reverse Cuthill-McKee) with a dense border (bodies, arc lengths,
-  multipliers: :class:`.bordered_band.BorderedBand`), kept across steps and factorized afresh
-  at the current iterate when the iteration contracts slower than
-  :data:`~.alpha_step.SLOW_CONTRACTION`, as :func:`~.alpha_step.solve_step` does;
+- the residual is the wires' rows and the rest's (:mod:`.alpha_chunk_residual`), the rest on
+  whole-wire windows or, when windows move, on a proxy element of each wire filled at run time
+  with the element holding the point;
+- the iteration matrix is the step's Jacobian (but for what a point adds to the wires' own
+  block), factorized in the code as a band (the wires, ordered by reverse Cuthill-McKee) with a
+  dense border (bodies, arc lengths, multipliers: :class:`.bordered_band.BorderedBand`), kept
+  across steps; when the iteration contracts slower than
+  :data:`~.alpha_step.SLOW_CONTRACTION` its border is renewed at the current iterate, then the
+  whole matrix, as :func:`~.alpha_step.solve_step` prepares the rest, then refactorizes;
 - a step that fails even with a fresh matrix (divergence, :data:`MAX_ITERATIONS`, a
   non-finite update) ends the call; that step is then taken by
   :meth:`.alpha_integrator.Integrator.advance` (its own matrices, halving) and the compiled
   steps resume after it.
 
 The results are the Python steps' to the Newton tolerance. Models with wheel/rail contacts
-(events), a border of more than :data:`MAX_BORDER` unknowns or a band of more than
-:data:`MAX_BAND_ENTRIES` entries (a line: its steps' Python overhead is small against its
-arithmetic) keep the Python steps."""
+(events), windows that move without proxy elements, a border of more than :data:`MAX_BORDER`
+unknowns or a band factorization of more than :data:`MAX_BAND_WORK` operations (a line: its
+steps' Python overhead is small against its arithmetic) keep the Python steps."""
 from __future__ import annotations
 
 import logging
@@ -61,7 +62,7 @@ MAX_BAND_WORK = 60_000
 
 #: This module's and the factorization's code, part of the compiled library's key.
 _SOURCE = b"".join((Path(__file__).parent / name).read_bytes()
-                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "bordered_band.py"))
+                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "bordered_band.py", "alpha_proxies.py"))
 
 
 class CompiledSteps:
@@ -161,12 +162,12 @@ class CompiledSteps:
 
 def unsupported(integ: Integrator) -> str | None:
     """Why ``integ``'s steps cannot run compiled, or None: wheel/rail contacts (events), or
-    element windows that move."""
+    element windows that move without proxy elements."""
     if integ.model.wheelrail:
         return "wheel/rail contacts"
-    if integ.model.windows_move():
-        return (f"element windows that move (a wire of more than {integ.model.window_size} elements under a "
-                "point: the code would hold all of them)")
+    if integ.model.windows_move() and integ.stepper.proxies is None:
+        return ("element windows that move, without proxy elements (see symcat.integrate.alpha_proxies: "
+                "the code would hold every element under a point)")
     return None
 
 
@@ -271,8 +272,6 @@ def _chunk_function(st: StepEquations, coef, per: int) -> ca.Function:
     wanted = ca.logic_and(active, renew)
     f_k = refresh(wanted, y_k, p_k, factor)
     fr, factorizations = wanted, wanted
-    if border:  # the border at every step's predictor, as the Python steps prepare the rest
-        f_k = refresh_border(ca.logic_and(active, ca.logic_not(renew)), y_k, p_k, f_k)
     e, stat, cnt = ca.MX(0), ca.if_else(active, 0, 1), ca.MX(0)  # an inactive step: "converged" untouched
     for round_ in range(ROUNDS):
         for _ in range(MAX_ITERATIONS // ROUNDS):
