@@ -187,7 +187,7 @@ def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> Buffe
             fn = _chunk_function(st, coef, per)
         return write_functions_c([fn], "alpha_chunk", folder)
 
-    path = compiled_library("alpha_chunk", key, write, mode="now", build=build)
+    path = compiled_library("alpha_chunk", key, write, build=build)  # -O0 first, optimized in the background
     return None if path is None else BufferedFunction(ca.external("alpha_chunk", str(path)))
 
 
