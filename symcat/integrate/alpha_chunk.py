@@ -46,9 +46,12 @@ from .bordered_band import BorderedBand
 
 log = logging.getLogger(__name__)
 
-#: Steps per compiled call at most (the code holds one call of the step per step; a call with
-#: fewer skips the others, so one library serves every step size and output interval).
-MAX_STEPS = 32
+#: The compiled calls' lengths in steps (the code holds one call of the step per step; a call
+#: takes the shortest that covers an output interval and skips the steps past it, so one
+#: library serves every step size and output interval; a skipped step still copies the state
+#: and the factor, which on a short interval in a 32-step call cost more than the steps).
+LENGTHS = (1, 2, 4, 8, 16, 32)
+MAX_STEPS = LENGTHS[-1]
 #: Newton iterations of a compiled step before it counts as failed (the iteration matrix is
 #: factorized afresh at most :data:`ROUNDS` - 1 times in a step).
 MAX_ITERATIONS = 18
@@ -72,7 +75,7 @@ class CompiledSteps:
 
     def __init__(self, integ: Integrator, h: float, per: int, build: bool = True):
         self.integ, self.h, self.per, self.build = integ, h, min(int(per), MAX_STEPS), build
-        self._fn = None
+        self._fns = None  # length -> compiled function
         self._factor = None  # the iteration matrix's factor the compiled steps carry
         self._renew = True  # factorize it at the next call's first step
         self._scale = None
@@ -102,7 +105,7 @@ class CompiledSteps:
 
     def _ready(self, s: State, t: float) -> bool:
         """Whether the compiled steps can run (building or loading them at the first call)."""
-        if self._fn is not None:
+        if self._fns is not None:
             return True
         integ, st = self.integ, self.integ.stepper
         if st.mass_scale is None:  # the scale of the multipliers' tolerance (a Python factorization)
@@ -116,8 +119,8 @@ class CompiledSteps:
                 self.disabled = (f"{layout.n_r} unknowns besides the wires' (at most {MAX_BORDER}), a band "
                                  f"factorization of {work} operations (at most {MAX_BAND_WORK})")
                 return False
-            self._fn = _compiled(st, self.integ.coef, graph, self.build)
-            if self._fn is None:
+            self._fns = _compiled(st, self.integ.coef, graph, self.build)
+            if self._fns is None:
                 self.disabled = "not compiled yet, and a short run (see generalized_alpha's compiled)"
                 return False
         except (RuntimeError, CompilerError) as exc:  # no compiler, or a kernel without SX form
@@ -133,11 +136,12 @@ class CompiledSteps:
         """``(steps done, state after them, Newton iterations)`` of one compiled call of at most
         ``min(n, per)`` steps from ``s`` at ``t``."""
         per, h = self.per, self.h
-        x, self._factor, its, factorizations = self._fn.nonzeros(
-            self._pack(s), t + h * np.arange(MAX_STEPS), h, min(n, per), self._factor, float(self._renew), self._scale)
+        length = next(L for L in LENGTHS if L >= min(n, per))
+        x, self._factor, its, factorizations = self._fns[length].nonzeros(
+            self._pack(s), t + h * np.arange(length), h, min(n, per), self._factor, float(self._renew), self._scale)
         self.integ.stepper.bulk.factorizations += int(factorizations[0])
         failed = np.flatnonzero(its <= 0)
-        done = min(int(failed[0]) if failed.size else per, n)
+        done = min(int(failed[0]) if failed.size else length, n, per)
         self._renew = done < min(n, per)  # a failure: renew the matrix where the next call starts
         if done:
             s = self._unpack(x)
@@ -171,24 +175,25 @@ def unsupported(integ: Integrator) -> str | None:
     return None
 
 
-def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> BufferedFunction | None:
-    """The compiled function of :func:`_chunk_function`, from the cache or (``build``)
-    generated now; None if not cached and not ``build``."""
+def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> dict | None:
+    """The compiled functions of :func:`_chunk_functions` by length, from the cache or
+    (``build``) generated now; None if not cached and not ``build``."""
     from ..codegen.model_dae import compiled_library
 
-    per = MAX_STEPS
-    settings = (per, MAX_ITERATIONS, ROUNDS, SLOW_CONTRACTION, st.variant, coef.rho_inf)
+    settings = (LENGTHS, MAX_ITERATIONS, ROUNDS, SLOW_CONTRACTION, st.variant, coef.rho_inf)
     # The residual over the compiled kernels names the model; the rest of the code follows
     # from this module's source and the settings.
     key = graph.serialize().encode() + repr(settings).encode() + b"|alpha_chunk|" + _SOURCE
 
     def write(folder):
         with symbolic_kernels():
-            fn = _chunk_function(st, coef, per)
-        return write_functions_c([fn], "alpha_chunk", folder)
+            fns = _chunk_functions(st, coef)
+        return write_functions_c(fns, "alpha_chunk", folder)
 
     path = compiled_library("alpha_chunk", key, write, build=build)  # -O0 first, optimized in the background
-    return None if path is None else BufferedFunction(ca.external("alpha_chunk", str(path)))
+    if path is None:
+        return None
+    return {length: BufferedFunction(ca.external(f"alpha_chunk_{length}", str(path))) for length in LENGTHS}
 
 
 def _graph(residual: ChunkResidual) -> ca.Function:
@@ -197,10 +202,10 @@ def _graph(residual: ChunkResidual) -> ca.Function:
     return ca.Function("alpha_chunk_residual", [y, p], list(residual.rows_and_shift(y, p)))
 
 
-def _chunk_function(st: StepEquations, coef, per: int) -> ca.Function:
-    """``alpha_chunk(x0, t (per), h, n, factor, renew, scale) -> (x, factor, iterations (per),
-    factorizations)``: up to ``n`` steps of ``h`` from the packed state ``x0`` at the times
-    ``t``, with the iteration matrix's ``factor`` (factorized at the first step's predictor if
+def _chunk_functions(st: StepEquations, coef) -> list:
+    """``alpha_chunk_<per>(x0, t (per), h, n, factor, renew, scale) -> (x, factor, iterations
+    (per), factorizations)`` for each ``per`` of :data:`LENGTHS`: up to ``n`` steps of ``h``
+    from the packed state ``x0`` at the times ``t``, with the iteration matrix's ``factor`` (factorized at the first step's predictor if
     ``renew``); ``x`` is the state after the last step that converged and ``factor`` the one
     the steps ended with; a step's iterations are 0 (not taken: past ``n`` or after a failure)
     or -1 (failed)."""
@@ -299,14 +304,17 @@ def _chunk_function(st: StepEquations, coef, per: int) -> ca.Function:
     step = ca.Function.if_else("alpha_chunk_step_or_skip", step, skip)
     # A loop of calls, not mapaccum: its code copies the inputs common to the steps once per
     # step, which cost more than the steps.
-    x0, times = ca.MX.sym("x0", n_x), ca.MX.sym("t", per)
-    x, f_out, counts, total = x0, factor, [], 0
-    for k in range(per):  # a failed step leaves the state as it was: x is the last good one
-        x, f_out, count, fk = step(k < n, x, f_out, renew if k == 0 else 0, times[k], h, k, n, scale)
-        counts.append(count)
-        total += fk
-    return ca.Function("alpha_chunk", [x0, times, h, n, factor, renew, scale],
-                       [x, f_out, ca.vertcat(*counts), total])
+    functions = []
+    for per in LENGTHS:
+        x0, times = ca.MX.sym("x0", n_x), ca.MX.sym("t", per)
+        x, f_out, counts, total = x0, factor, [], 0
+        for k in range(per):  # a failed step leaves the state as it was: x is the last good one
+            x, f_out, count, fk = step(k < n, x, f_out, renew if k == 0 else 0, times[k], h, k, n, scale)
+            counts.append(count)
+            total += fk
+        functions.append(ca.Function(f"alpha_chunk_{per}", [x0, times, h, n, factor, renew, scale],
+                                     [x, f_out, ca.vertcat(*counts), total]))
+    return functions
 
 
 def _layout(st: StepEquations) -> BorderedBand:
