@@ -40,7 +40,8 @@ from ..codegen.library import BufferedFunction, symbolic_kernels
 from ..dae.formulation import Formulation
 from ..errors import SolverError
 from .alpha_bulk import Bulk, step_data
-from .alpha_proxies import Proxies, move_back
+from .alpha_placement import Placement, Terms, capacitance_keys, identity, output_maps
+from .alpha_proxies import Proxies
 from .alpha_rest import compiled_rest, expanded_rest
 
 #: Unknowns of the rest above which its capacitance is factorized sparse (a vehicle's bodies,
@@ -129,6 +130,13 @@ class StepEquations:
         colind, row = jac.sparsity_out(0).get_ccs()
         self._jac_rows = np.array(row, int)
         self._jac_cols = self.rest_columns[np.repeat(np.arange(k), np.diff(colind))]
+        self._placements: dict[tuple, Placement] = {}
+        if self.proxies is None:
+            n_p = self.p_columns.size
+            self._placements[()] = Placement(
+                Terms(np.arange(k), self.rest_columns, np.ones(k), np.zeros(k)),
+                Terms(np.arange(n_p), self.p_columns, np.ones(n_p), np.zeros(n_p)), np.zeros(0),
+                *output_maps(identity, self._r_rows, self._shift_rows, self._jac_rows, self._jac_cols), n_y, n_u)
         self.mass_scale = mass_scale  # kg: mean diagonal of M, converts multiplier updates to positions
         # Few wire unknowns against the rest (the seed's 8-element wire under a vehicle, or no
         # wire): the whole step matrix is factorized (sparse LU) instead of corrected by a
@@ -194,24 +202,26 @@ class StepEquations:
         return k
 
     # --- evaluation ---------------------------------------------------------------------------
-    def _inputs(self, y, p):
-        """The rest's inputs at ``(y, p)`` and the proxies' maps (None without proxies)."""
+    def _placement(self, y) -> Placement:
+        """The rest's index maps for the elements that hold the contact points in ``y``."""
         if self.proxies is None:
-            return y[self.rest_columns], p[self.p_columns], np.zeros(0), self.mode, None
-        y_rest, p_rest, w, maps = self.proxies.substitute(y, p)
-        return y_rest, p_rest, w, self.mode, maps
+            return self._placements[()]
+        key = self.proxies.key(y)
+        found = self._placements.get(key)
+        if found is None:
+            if len(self._placements) > 64:
+                self._placements.clear()
+            y_terms, p_terms, w, expand = self.proxies.placement(key)
+            found = self._placements[key] = Placement(
+                y_terms, p_terms, w, *output_maps(expand, self._r_rows, self._shift_rows, self._jac_rows, self._jac_cols),
+                self.n_y, self.n_u)
+        return found
 
     def _rest_values(self, y, p):
         """The rest's residual (n_y) and shift (n_u) at ``(y, p)``, dense."""
-        y_rest, p_in, w, mode, maps = self._inputs(y, p)
-        r_nz, shift_nz, *_ = self._rest.nonzeros(y_rest, p_in, w, mode)
-        r, shift = np.zeros(self.n_y), np.zeros(self.n_u)
-        r[self._r_rows] = r_nz
-        shift[self._shift_rows] = shift_nz
-        if maps is not None:
-            move_back(r, maps)
-            move_back(shift, maps)
-        return r, shift
+        placement = self._placement(y)
+        r_nz, shift_nz, *_ = self._rest.nonzeros(*placement.inputs(y, p), self.mode)
+        return placement.residual(r_nz, shift_nz)
 
     def residual(self, y, p) -> np.ndarray:
         r, shift = self._rest_values(y, p)
@@ -230,8 +240,7 @@ class StepEquations:
         if self.n_sc:
             y[self.n_y - self.n_sc :] = sc
         p = np.r_[u, v, np.zeros(n_u), t, 1.0, 1.0, 1.0]
-        y_rest, p_in, w, mode, _ = self._inputs(y, p)
-        _, _, gap, force = self._rest.nonzeros(y_rest, p_in, w, mode)
+        _, _, gap, force = self._rest.nonzeros(*self._placement(y).inputs(y, p), self.mode)
         return gap, force
 
     def update(self, y, p) -> tuple:
@@ -247,19 +256,13 @@ class StepEquations:
         return self.bulk.mass(y[: self.form.n_f])
 
     def _rest_triplets(self, y, p):
-        """The rest's exact Jacobian as (rows, columns, values), nonzero values only, with the
+        """The rest's exact Jacobian as (rows, columns, values) (duplicates add), with the
         bulk rows' dependence on ``nu`` through the shift of ``a`` under the stabilized form:
-        ``-(c_m M + gamma h C) G^T`` with the constant bulk mass and Rayleigh matrices."""
-        y_rest, p_in, w, mode, maps = self._inputs(y, p)
-        values = self._rest_jacobian.nonzeros(y_rest, p_in, w, mode)[0]
-        keep = values != 0
-        rows, cols, data = self._jac_rows[keep], self._jac_cols[keep], values[keep]
-        if maps is not None:  # the proxies' rows and columns are made of the actual elements'
-            # J_actual = T^T J_proxy T, T the maps of the proxy coordinates
-            at, rows, weight = self.proxies.expand(maps, rows)
-            cols, data = cols[at], data[at] * weight
-            at, cols, weight = self.proxies.expand(maps, cols)
-            rows, data = rows[at], data[at] * weight
+        ``-(c_m M + gamma h C) G^T`` with the constant bulk mass and Rayleigh matrices; and the
+        capacitance's ``(keys, flat, k)`` (:meth:`.Placement.touched`)."""
+        placement = self._placement(y)
+        values = self._rest_jacobian.nonzeros(*placement.inputs(y, p), self.mode)[0]
+        rows, cols, data = placement.jac_rows, placement.jac_cols, placement.jacobian(values)
         n_b, n_u, n_c = self.bulk.n_b, self.n_u, self.n_c
         if self.variant == "stabilized" and n_b:
             g = (rows >= n_u) & (rows < n_u + n_c) & (cols < n_b)  # G on the bulk coordinates
@@ -273,12 +276,13 @@ class StepEquations:
                 rows = np.r_[rows, extra.row]
                 cols = np.r_[cols, n_u + n_c + extra.col]
                 data = np.r_[data, extra.data]
-        return rows, cols, data
+                return rows, cols, data, capacitance_keys(rows, cols, n_b, self.n_y)
+        return rows, cols, data, placement.touched(n_b)
 
     def jacobian(self, y, p) -> sps.csc_matrix:
         """The whole step Jacobian at ``(y, p)`` (bulk and rest; the starting acceleration's
         filter needs it once)."""
-        rows, cols, data = self._rest_triplets(y, p)
+        rows, cols, data, _ = self._rest_triplets(y, p)
         jac = sps.csc_matrix((data, (rows, cols)), shape=(self.n_y, self.n_y))
         n_b = self.bulk.n_b
         if n_b:
@@ -315,18 +319,14 @@ class StepEquations:
             self._prepared = (float(p[3 * self.n_u + 1]), self.mode.copy())
             return
         n_b, n_y = self.bulk.n_b, self.n_y
-        r_i, c_i, data = self._rest_triplets(y, p)
-        touched = np.unique(np.concatenate([r_i[r_i < n_b], c_i[c_i < n_b]]))
-        keys = np.concatenate([touched, np.arange(n_b, n_y)])
-        pos = np.full(n_y, -1)
-        pos[keys] = np.arange(keys.size)
-        k = keys.size
-        n_t = touched.size
+        *_, data, (keys, flat, k) = self._rest_triplets(y, p)
+        n_t = k - (n_y - n_b)
+        touched = keys[:n_t]
         z_bulk = self.bulk.columns(touched) if n_t else np.zeros((n_b, 0))
         if k > DENSE_CAPACITANCE:
             # Bodies with many coordinates (a vehicle on a line): the capacitance is the rest's
             # sparse Jacobian but for the block of the touched wire unknowns.
-            delta = sps.csr_matrix((data, (pos[r_i], pos[c_i])), shape=(k, k))
+            delta = sps.csr_matrix((data, (flat // k, flat % k)), shape=(k, k))
             delta = (delta - sps.diags(np.r_[np.zeros(n_t), np.ones(k - n_t)])).tocsr()
             z_k = sps.block_diag([sps.csr_matrix(z_bulk[touched]), sps.identity(k - n_t)], format="csr")
             try:
@@ -336,8 +336,7 @@ class StepEquations:
             self._coupling = (keys, n_t, delta, z_bulk, cap)
             self._prepared = (float(p[3 * self.n_u + 1]), self.mode.copy())
             return
-        delta = np.zeros((k, k))
-        np.add.at(delta, (pos[r_i], pos[c_i]), data)
+        delta = np.bincount(flat, data, minlength=k * k).reshape(k, k)
         delta[n_t:, n_t:] -= np.eye(k - n_t)
         z_k = np.eye(k)
         if n_t:
