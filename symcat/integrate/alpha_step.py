@@ -53,6 +53,7 @@ KEPT_ITERATIONS = 4
 #: A Newton iteration that contracts by less than this per iteration updates its matrix.
 SLOW_CONTRACTION = 0.3
 
+_GETRS = sla.get_lapack_funcs("getrs", dtype=np.float64)
 _SINGULAR = ("generalized-alpha: singular iteration matrix (redundant constraints, or a sliding joint at a point "
              "where its wire has no tangent?)")
 
@@ -371,7 +372,10 @@ class StepEquations:
         n_b = self.bulk.n_b
         x = rhs.copy()
         x[:n_b] = self.bulk.solve(rhs[:n_b])
-        w = cap.solve(delta @ x[keys]) if isinstance(cap, spla.SuperLU) else sla.lu_solve(cap, delta @ x[keys], check_finite=False)
+        if isinstance(cap, spla.SuperLU):
+            w = cap.solve(delta @ x[keys])
+        else:  # LAPACK directly: lu_solve's checks cost as much as this small solve
+            w = _GETRS(*cap, delta @ x[keys])[0]
         x[:n_b] -= z_bulk @ w[:n_t]
         x[n_b:] -= w[n_t:]
         return x
