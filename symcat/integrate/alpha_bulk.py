@@ -187,9 +187,13 @@ class Bulk:
             if len(self._columns) + len(missing) > MAX_COLUMNS:
                 self._columns.clear()
                 missing = index.tolist()
-            e = np.zeros((self.n_b, len(missing)))
-            e[missing, np.arange(len(missing))] = 1.0
-            for i, col in zip(missing, self.lu.solve(e).T):
+            if isinstance(self.lu, BandedCholesky):
+                solved = self.lu.columns(np.array(missing))
+            else:
+                e = np.zeros((self.n_b, len(missing)))
+                e[missing, np.arange(len(missing))] = 1.0
+                solved = self.lu.solve(e)
+            for i, col in zip(missing, solved.T):
                 self._columns[i] = col
         for k, i in enumerate(index.tolist()):
             out[:, k] = self._columns[i]
