@@ -54,6 +54,14 @@ class Placement:
         self.jac_nonzero, self.jac_rows, self.jac_cols, self.jac_weight = jac
         # the bulk unknowns (< n_b) in the Jacobian's rows and columns, per n_b: see touched()
         self._touched: dict[int, tuple] = {}
+        self.cache: dict = {}  # what the step equations keep for this placement
+
+    def add_terms(self, rows: np.ndarray, cols: np.ndarray) -> None:
+        """Append terms of a fixed pattern to :attr:`jac_rows` and :attr:`jac_cols` (their
+        values follow :meth:`jacobian`'s)."""
+        self.jac_rows, self.jac_cols = np.r_[self.jac_rows, rows], np.r_[self.jac_cols, cols]
+        self._touched.clear()
+        self.cache.pop("csc", None)
 
     def inputs(self, y: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The rest's ``y`` and ``p`` inputs and the proxies' element data ``w``."""
@@ -77,6 +85,14 @@ class Placement:
         if found is None:
             found = self._touched[n_b] = capacitance_keys(self.jac_rows, self.jac_cols, n_b, self.n_y)
         return found
+
+
+def csc_pattern(rows: np.ndarray, cols: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(place, indices, indptr)``: each term's place in the data of the ``n x n`` CSC matrix
+    of the pattern ``(rows, cols)`` (duplicates share one), for ``bincount(place, values)``."""
+    unique, place = np.unique(np.asarray(cols, np.int64) * n + rows, return_inverse=True)
+    indptr = np.searchsorted(unique // n, np.arange(n + 1))
+    return place, unique % n, indptr
 
 
 def capacitance_keys(rows: np.ndarray, cols: np.ndarray, n_b: int, n_y: int) -> tuple[np.ndarray, np.ndarray, int]:

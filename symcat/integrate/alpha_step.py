@@ -40,7 +40,7 @@ from ..codegen.library import BufferedFunction, symbolic_kernels
 from ..dae.formulation import Formulation
 from ..errors import SolverError
 from .alpha_bulk import Bulk, step_data
-from .alpha_placement import Placement, Terms, capacitance_keys, identity, output_maps
+from .alpha_placement import Placement, Terms, csc_pattern, identity, output_maps
 from .alpha_proxies import Proxies
 from .alpha_rest import compiled_rest, expanded_rest
 
@@ -256,41 +256,64 @@ class StepEquations:
         """The mass matrix (free coordinates, scipy sparse) at the positions of ``y``."""
         return self.bulk.mass(y[: self.form.n_f])
 
-    def _rest_triplets(self, y, p):
-        """The rest's exact Jacobian as (rows, columns, values) (duplicates add), with the
-        bulk rows' dependence on ``nu`` through the shift of ``a`` under the stabilized form:
-        ``-(c_m M + gamma h C) G^T`` with the constant bulk mass and Rayleigh matrices; and the
-        capacitance's ``(keys, flat, k)`` (:meth:`.Placement.touched`)."""
+    def _rest_triplets(self, y, p) -> tuple[Placement, np.ndarray]:
+        """The rest's exact Jacobian at ``(y, p)``: its placement, whose ``jac_rows`` and
+        ``jac_cols`` are the terms' rows and columns (duplicates add), and their values."""
         placement = self._placement(y)
         values = self._rest_jacobian.nonzeros(*placement.inputs(y, p), self.mode)[0]
-        rows, cols, data = placement.jac_rows, placement.jac_cols, placement.jacobian(values)
+        data = placement.jacobian(values)
+        extra = self._shift_coupling(placement, data, p)
+        return placement, data if extra is None else np.concatenate([data, extra])
+
+    def _shift_coupling(self, placement: Placement, data, p) -> np.ndarray | None:
+        """The bulk rows' dependence on ``nu`` through the shift of ``a`` under the stabilized
+        form, ``-(c_m M + gamma h C) G^T`` with the constant bulk mass and Rayleigh matrices:
+        the values of terms (dense on the rows it reaches, appended to the placement's pattern
+        at the first call) given the rest's Jacobian values ``data``; None if there are none."""
         n_b, n_u, n_c = self.bulk.n_b, self.n_u, self.n_c
-        if self.variant == "stabilized" and n_b:
-            g = (rows >= n_u) & (rows < n_u + n_c) & (cols < n_b)  # G on the bulk coordinates
-            if np.any(g):
-                _, _, _, _, _, gh, cm = step_data(p, n_u)
+        if self.variant != "stabilized" or not n_b:
+            return None
+        found = placement.cache.get("shift")
+        if found is None:
+            rows, cols = placement.jac_rows, placement.jac_cols
+            g = np.flatnonzero((rows >= n_u) & (rows < n_u + n_c) & (cols < n_b))  # G on the bulk coordinates
+            found = None
+            if g.size:
                 g_cols, at = np.unique(cols[g], return_inverse=True)
-                g_b = np.zeros((g_cols.size, n_c))  # G^T on the bulk columns it touches
-                np.add.at(g_b, (at, rows[g] - n_u), data[g])
-                block = cm * self.bulk.mass_matrix[:, g_cols] + gh * self.bulk.rayleigh[:, g_cols]
-                extra = (-(block @ sps.csr_matrix(g_b))).tocoo()
-                rows = np.r_[rows, extra.row]
-                cols = np.r_[cols, n_u + n_c + extra.col]
-                data = np.r_[data, extra.data]
-                return rows, cols, data, capacitance_keys(rows, cols, n_b, self.n_y)
-        return rows, cols, data, placement.touched(n_b)
+                reach = abs(self.bulk.mass_matrix[:, g_cols]) + abs(self.bulk.rayleigh[:, g_cols])
+                reached = np.unique(reach.nonzero()[0])
+                found = (g, g_cols, at, rows[g] - n_u, reached)
+                placement.add_terms(np.repeat(reached, n_c), np.tile(n_u + n_c + np.arange(n_c), reached.size))
+            placement.cache["shift"] = found
+        if found is None:
+            return None
+        g, g_cols, at, g_rows, reached = found
+        _, _, _, _, _, gh, cm = step_data(p, n_u)
+        block = placement.cache.get("block")
+        if block is None or block[0] != (gh, cm):
+            dense = (cm * self.bulk.mass_matrix[reached][:, g_cols] + gh * self.bulk.rayleigh[reached][:, g_cols])
+            block = placement.cache["block"] = ((gh, cm), dense.toarray())
+        g_b = np.zeros((g_cols.size, n_c))  # G^T on the bulk columns it touches
+        np.add.at(g_b, (at, g_rows), data[g])
+        return -(block[1] @ g_b).ravel()
 
     def jacobian(self, y, p) -> sps.csc_matrix:
-        """The whole step Jacobian at ``(y, p)`` (bulk and rest; the starting acceleration's
-        filter needs it once)."""
-        rows, cols, data, _ = self._rest_triplets(y, p)
-        jac = sps.csc_matrix((data, (rows, cols)), shape=(self.n_y, self.n_y))
-        n_b = self.bulk.n_b
+        """The whole step Jacobian at ``(y, p)`` (bulk and rest), assembled on a pattern kept
+        per placement."""
+        placement, data = self._rest_triplets(y, p)
+        n_b, n_y = self.bulk.n_b, self.n_y
         if n_b:
             shift = self._rest_values(y, p)[1]
-            a = self.bulk.jacobian.sparse(y[:n_b], p, shift[:n_b])[0]
-            jac = jac + sps.block_diag([a, sps.csc_matrix((self.n_y - n_b,) * 2)], format="csc")
-        return jac.tocsc()
+            data = np.concatenate([data, self.bulk.jacobian.nonzeros(y[:n_b], p, shift[:n_b])[0]])
+        pattern = placement.cache.get("csc")
+        if pattern is None:
+            rows, cols = placement.jac_rows, placement.jac_cols
+            if n_b:
+                bulk_rows, bulk_cols = self.bulk.jacobian.function.sparsity_out(0).get_triplet()
+                rows, cols = np.r_[rows, bulk_rows], np.r_[cols, bulk_cols]
+            pattern = placement.cache["csc"] = csc_pattern(rows, cols, n_y)
+        place, indices, indptr = pattern
+        return sps.csc_matrix((np.bincount(place, data, minlength=indices.size), indices, indptr), shape=(n_y, n_y))
 
     # --- the linear solve ---------------------------------------------------------------------
     def factorize(self, y, p) -> None:
@@ -320,7 +343,8 @@ class StepEquations:
             self._prepared = (float(p[3 * self.n_u + 1]), self.mode.copy())
             return
         n_b, n_y = self.bulk.n_b, self.n_y
-        *_, data, (keys, flat, k) = self._rest_triplets(y, p)
+        placement, data = self._rest_triplets(y, p)
+        keys, flat, k = placement.touched(n_b)
         n_t = k - (n_y - n_b)
         touched = keys[:n_t]
         z_bulk = self.bulk.columns(touched) if n_t else np.zeros((n_b, 0))

@@ -150,3 +150,17 @@ def test_banded_columns_are_the_solves():
         e[index, np.arange(index.size)] = 1.0
         exact = lu.solve(e)
         np.testing.assert_allclose(lu.columns(index), exact, rtol=0, atol=1e-14 * np.abs(exact).max())
+
+
+def test_kept_patterns_give_a_fresh_builds_jacobian(line):
+    """The Jacobian assembled on the pattern kept from an earlier evaluation (and the shift
+    coupling's dense block kept for the step coefficients) equals that of equations built afresh,
+    at another point and another step size."""
+    form = Formulation(line, "augmented", "1")
+    used, fresh = StepEquations(form, "stabilized"), StepEquations(form, "stabilized")
+    rng = np.random.default_rng(8)
+    used.jacobian(*_point(used, line, rng))
+    y, p = _point(used, line, rng)
+    p[3 * used.n_u + 1 :] *= [0.25, 0.5, 1.0]  # half the step
+    ja, jb = used.jacobian(y, p), fresh.jacobian(y, p)
+    assert abs(ja - jb).max() <= 1e-12 * abs(jb).max()
