@@ -109,13 +109,8 @@ class Integrator:
         bh2 = self.coef.beta * h * h
         ratio = h / s.h
         a_prev, lam_prev, sc_prev = s.prev
-        c = self.coef
-        am, af = c.alpha_m, c.alpha_f
-        vdot_prev = ((1 - am) * s.a + am * a_prev - (1 - af) * s.v_dot) / af if af > 0 else s.v_dot
-        vdot = s.v_dot + ratio * (s.v_dot - vdot_prev)
-        a = ((1 - af) * vdot + af * s.v_dot - am * s.a) / (1 - am)
         y = np.zeros(st.n_y)
-        y[:n_u] = p[:n_u] + bh2 * a
+        y[:n_u] = p[:n_u] + bh2 * (s.a + ratio * (s.a - a_prev))
         y[n_u : n_u + n_c] = bh2 * (s.lam + ratio * (s.lam - lam_prev))
         if n_sc:
             y[st.n_y - n_sc :] = s.sc + ratio * (s.sc - sc_prev)

@@ -81,10 +81,18 @@ class StepEquations:
         n_u = self.n_u
         self.n_y = n_y = n_u + n_c * (2 if variant == "stabilized" else 1) + n_sc
         self.variant, self.form = variant, form
-        self.bulk = bulk if bulk is not None else Bulk(form, n_u, expand)
+        model = form.model
+        # Few wire unknowns against the rest (the seed's 8-element wire under a vehicle, or no
+        # wire): the whole step matrix is factorized (sparse LU) instead of corrected by a
+        # Woodbury update, whose capacitance is then as large as the system and, with the
+        # stiff cross-section gradients of beam3d wires, too ill-conditioned to solve accurately.
+        n_b = int(np.count_nonzero(model.free < model.ancf.n))
+        self.direct = n_b <= n_y - n_b
+        # The bulk's Jacobian is then evaluated at every factorization: expanded to scalar
+        # operations (small here), three times faster than its graph.
+        self.bulk = bulk if bulk is not None else Bulk(form, n_u, expand or self.direct)
         y = ca.MX.sym("y", n_y)
         p = ca.MX.sym("p", 3 * n_u + 4)
-        model = form.model
         # The open flags of the wheel/rail contacts (1: lifted off), set by an event handler.
         self.mode = np.zeros(len(model.wheelrail))
         self.mode_symbol = mode = ca.MX.sym("mode", self.mode.size)
@@ -139,11 +147,6 @@ class StepEquations:
                 Terms(np.arange(n_p), self.p_columns, np.ones(n_p), np.zeros(n_p)), np.zeros(0),
                 *output_maps(identity, self._r_rows, self._shift_rows, self._jac_rows, self._jac_cols), n_y, n_u)
         self.mass_scale = mass_scale  # kg: mean diagonal of M, converts multiplier updates to positions
-        # Few wire unknowns against the rest (the seed's 8-element wire under a vehicle, or no
-        # wire): the whole step matrix is factorized (sparse LU) instead of corrected by a
-        # Woodbury update, whose capacitance is then as large as the system and, with the
-        # stiff cross-section gradients of beam3d wires, too ill-conditioned to solve accurately.
-        self.direct = self.bulk.n_b <= self.n_y - self.bulk.n_b
         self._coupling = None
         # (beta h^2, open flags) of a sparse capacitance that later steps may keep (see
         # :meth:`keeps_coupling`), else None.
@@ -280,21 +283,22 @@ class StepEquations:
             found = None
             if g.size:
                 g_cols, at = np.unique(cols[g], return_inverse=True)
+                g_rows, row_at = np.unique(rows[g] - n_u, return_inverse=True)  # the constraints on the bulk
                 reach = abs(self.bulk.mass_matrix[:, g_cols]) + abs(self.bulk.rayleigh[:, g_cols])
                 reached = np.unique(reach.nonzero()[0])
-                found = (g, g_cols, at, rows[g] - n_u, reached)
-                placement.add_terms(np.repeat(reached, n_c), np.tile(n_u + n_c + np.arange(n_c), reached.size))
+                found = (g, g_cols, at, row_at, g_rows.size, reached)
+                placement.add_terms(np.repeat(reached, g_rows.size), np.tile(n_u + n_c + g_rows, reached.size))
             placement.cache["shift"] = found
         if found is None:
             return None
-        g, g_cols, at, g_rows, reached = found
+        g, g_cols, at, row_at, n_g, reached = found
         _, _, _, _, _, gh, cm = step_data(p, n_u)
         block = placement.cache.get("block")
         if block is None or block[0] != (gh, cm):
             dense = (cm * self.bulk.mass_matrix[reached][:, g_cols] + gh * self.bulk.rayleigh[reached][:, g_cols])
             block = placement.cache["block"] = ((gh, cm), dense.toarray())
-        g_b = np.zeros((g_cols.size, n_c))  # G^T on the bulk columns it touches
-        np.add.at(g_b, (at, g_rows), data[g])
+        g_b = np.zeros((g_cols.size, n_g))  # G^T on the bulk columns it touches
+        np.add.at(g_b, (at, row_at), data[g])
         return -(block[1] @ g_b).ravel()
 
     def jacobian(self, y, p) -> sps.csc_matrix:
@@ -313,7 +317,9 @@ class StepEquations:
                 rows, cols = np.r_[rows, bulk_rows], np.r_[cols, bulk_cols]
             pattern = placement.cache["csc"] = csc_pattern(rows, cols, n_y)
         place, indices, indptr = pattern
-        return sps.csc_matrix((np.bincount(place, data, minlength=indices.size), indices, indptr), shape=(n_y, n_y))
+        jac = sps.csc_matrix((np.bincount(place, data, minlength=indices.size), indices, indptr), shape=(n_y, n_y))
+        jac.eliminate_zeros()  # the pattern's structural zeros (open contacts...) would cost the sparse LU
+        return jac
 
     # --- the linear solve ---------------------------------------------------------------------
     def factorize(self, y, p) -> None:
