@@ -24,6 +24,20 @@ def step_data(p, n_u):
             p[3 * n_u + 3])
 
 
+def bulk_rows(form: Formulation, n_b: int, n_u: int, y_b, p, shift_b) -> ca.MX:
+    """The bulk's rows of the scaled step residual (MX) at the bulk unknowns ``y_b``, step data
+    ``p`` and stabilization shift ``shift_b``: what :meth:`Bulk.residual` evaluates."""
+    model = form.model
+    zero = ca.MX(form.n_f - n_b, 1)
+    u_pred, v_pred, b, t, bh2, gh, cm = step_data(p, n_u)
+    a_b = (y_b - u_pred[:n_b] - shift_b) / bh2
+    q = form.q_fixed + ca.mtimes(form.P, ca.vertcat(y_b, zero))
+    v = ca.mtimes(form.P, ca.vertcat(v_pred[:n_b] + gh * a_b, zero))
+    m_all = ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(q, "bulk"), form.P))
+    f_b = ca.mtimes(form.P.T, model.forces(q, v, t, "bulk"))[:n_b]
+    return bh2 * (ca.mtimes(m_all[:n_b, :n_b], cm * a_b + b[:n_b]) - f_b)
+
+
 class Bulk:
     """The window-independent part of the step: the bulk's residual rows and Jacobian as
     functions of ``(y_b, p, shift_b)`` (the free ANCF coordinates come first among the
@@ -59,16 +73,9 @@ class Bulk:
         self._step = None  # (p, (B, c)) of the last step data, see residual()
         if not n_b:
             return
-        zero = ca.MX(form.n_f - n_b, 1)
         y_b, shift_b = ca.MX.sym("y_b", n_b), ca.MX.sym("shift_b", n_b)
         p = ca.MX.sym("p", 3 * n_u + 4)
-        u_pred, v_pred, b, t, bh2, gh, cm = step_data(p, n_u)
-        a_b = (y_b - u_pred[:n_b] - shift_b) / bh2
-        q = form.q_fixed + ca.mtimes(form.P, ca.vertcat(y_b, zero))
-        v = ca.mtimes(form.P, ca.vertcat(v_pred[:n_b] + gh * a_b, zero))
-        m_all = ca.mtimes(form.P.T, ca.mtimes(model.mass_matrix(q, "bulk"), form.P))
-        f_b = ca.mtimes(form.P.T, model.forces(q, v, t, "bulk"))[:n_b]
-        r_b = bh2 * (ca.mtimes(m_all[:n_b, :n_b], cm * a_b + b[:n_b]) - f_b)
+        r_b = bulk_rows(form, n_b, n_u, y_b, p, shift_b)
         fns = [ca.Function("alpha_bulk_jacobian", [y_b, p, shift_b], [ca.jacobian(r_b, y_b)])]
         if expand:
             try:

@@ -147,12 +147,20 @@ class Integrator:
             return self.advance(mid, t0 + 0.5 * h, 0.5 * h, depth + 1)
         self.stats["steps"] += 1
         self.stats["nsteps"] = self.stats["steps"]
-        x, z = self.layout(new)
-        if self.stepper.proxies is None and update_windows(self.model, self.form, x, z):
-            # The element windows are part of the equations' graph: rebuild them.
-            self.stepper = self._build(self.stepper)
-            self.stats["rebuilds"] += 1
+        self.move_windows(new)
         return new
+
+    def move_windows(self, s: State) -> bool:
+        """Move the element windows with their points at ``s``; True if the step's equations
+        were rebuilt (without proxy elements the windows are part of their graph)."""
+        if self.stepper.proxies is not None:
+            return False
+        x, z = self.layout(s)
+        if not update_windows(self.model, self.form, x, z):
+            return False
+        self.stepper = self._build(self.stepper)
+        self.stats["rebuilds"] += 1
+        return True
 
     def step_state(self, s: State, t: float) -> StepState:
         """The :class:`StepState` of ``s`` at time ``t`` (physical, all coordinates)."""

@@ -162,10 +162,10 @@ class StepEquations:
         self.mode[:] = 0.0
         self._coupling, self._prepared, self.last_iterations = None, None, 0
 
-    def _rows(self, y, p, mode, contacts: bool = False):
+    def _rows(self, y, p, mode, contacts: bool = False, part: str = "rest"):
         """The rest's scaled residual rows and the stabilization's shift ``G^T nu`` at ``(y,
         p)``: the step residual without the bulk's mass and forces (with ``contacts``, also the
-        penalty contacts' gaps and normal forces). The wheel/rail contacts' creep forces depend
+        penalty contacts' gaps and normal forces; ``part="all"``: the whole step's residual). The wheel/rail contacts' creep forces depend
         on their normal forces (the multipliers ``lambda = y_lambda / (beta h^2)``); an open
         contact (``mode`` 1) has its gap rows replaced by its multipliers, as in the DAE
         (:meth:`Formulation.dae`)."""
@@ -179,12 +179,12 @@ class StepEquations:
         if variant == "stabilized":
             nu = y[n_u + n_c : n_u + 2 * n_c]
             # C_q and C_s depend on positions only: the velocities of this probe are immaterial.
-            g = self._terms(form, q, ca.MX.zeros(n_f), s, ca.MX.zeros(n_s), t, sc)
+            g = self._terms(form, q, ca.MX.zeros(n_f), s, ca.MX.zeros(n_s), t, sc, part)
             shift = ca.vertcat(ca.mtimes(g["Cq"].T, nu), ca.mtimes(g["Cs"].T, nu))
         a = (u - u_pred - shift) / bh2
         v = v_pred + gh * a
         v_dot = cm * a + b
-        k = self._terms(form, q, v[:n_f], s, v[n_f:], t, sc)
+        k = self._terms(form, q, v[:n_f], s, v[n_f:], t, sc, part)
         dyn = ca.mtimes(k["M"], v_dot[:n_f]) - k["Q"]
         if has_creep(form.model):
             dyn -= form.creep_force(k, s, v[n_f:], lam_s / bh2)[0]
@@ -199,8 +199,8 @@ class StepEquations:
         return ca.vertcat(*rows), shift
 
     @staticmethod
-    def _terms(form, q, v, s, w, t, sc=None):
-        k = form.terms(q, v, s, w, t, sc, part="rest")
+    def _terms(form, q, v, s, w, t, sc=None, part="rest"):
+        k = form.terms(q, v, s, w, t, sc, part=part)
         if form.n_s == 0:  # an empty s would leave Cs 0 x 0 against n_c rows
             return {**k, "Cs": ca.MX(form.n_c, 0)}
         return k

@@ -86,6 +86,7 @@ from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
 from ..run_control import check_interrupt, integrating
+from .alpha_chunk import CompiledSteps
 from .alpha_coefficients import AlphaCoefficients
 from .alpha_events import integrate_alpha_events
 from .alpha_integrator import Integrator, StepFailure
@@ -94,10 +95,11 @@ from .results import SimulationResult
 from .simulate import one_handler
 
 VARIANTS = ("index3", "stabilized")
-#: Steps from which a run compiles its step's rest to C when no compiled one is cached (models
-#: with wheel/rail contacts; :class:`~.alpha_step.StepEquations`); a shorter run uses a cached
-#: one or the expanded functions. Compiling the seed scene's takes about 30 s (once per machine
-#: and parameter set); its compiled step then runs the scene about 1.5 times faster.
+#: Steps from which a run compiles its steps to C when no compiled ones are cached (the steps
+#: of :mod:`.alpha_chunk`; with wheel/rail contacts the rest of each step,
+#: :class:`~.alpha_step.StepEquations`); a shorter run uses cached ones or Python. Compiling
+#: takes seconds for a small wire, about 30 s for the seed scene's rest (once per machine and
+#: model), which a short run would not repay.
 COMPILE_STEPS = 2000
 
 
@@ -105,7 +107,7 @@ COMPILE_STEPS = 2000
 def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: float = 0.9,
                     variant: str = "stabilized", tol: float = 1e-10, max_iterations: int = 20, n_out: int = 200,
                     progress: bool = True, expand: bool = False, max_halvings: int = 4, monitor=None,
-                    handlers=None) -> AlphaRun:
+                    handlers=None, compiled: bool | None = None) -> AlphaRun:
     """Integrate ``model`` from its consistent initial state to ``t_end`` with fixed steps.
 
     Parameters are those of :func:`generalized_alpha`.
@@ -141,9 +143,8 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
         stats = {"steps": 0, "nsteps": 0, "newton_iterations": 0, "factorizations": 0, "rebuilds": 0, "halvings": 0,
                  "build_s": 0.0, "dt": dt, "rho_inf": coef.rho_inf, "variant": variant, "restarts": 0}
         # A short run uses a compiled step if one is cached and does not compile one.
-        compiled = True if t_end / dt >= COMPILE_STEPS else None
-        integ = Integrator(model, form, coef, variant, tol, int(max_iterations), max_halvings, expand, stats,
-                            compiled)
+        rest = (True if compiled or t_end / dt >= COMPILE_STEPS else None) if compiled is not False else False
+        integ = Integrator(model, form, coef, variant, tol, int(max_iterations), max_halvings, expand, stats, rest)
         try:
             return integrate_alpha_events(integ, form, handler, t_end, dt, int(n_out), tol, progress, wall0)
         finally:
@@ -163,6 +164,10 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
                  dt=h, rho_inf=coef.rho_inf, variant=variant)
     integ = Integrator(model, form, coef, variant, tol, int(max_iterations), max_halvings, expand, stats)
     state = integ.start(x, z, h)
+    # Without a per-step monitor the steps run compiled, many per call; a short run compiles
+    # them only if asked (``compiled=True``), else uses them if cached.
+    chunks = (CompiledSteps(integ, h, per, build=bool(compiled) or n_steps >= COMPILE_STEPS)
+              if compiled is not False and monitor is None else None)
     run.multipliers[0] = state.lam
 
     def contacts(t):
@@ -185,19 +190,22 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
     try:
         with integrating():
             for out in range(1, n_outputs + 1):
-                for _ in range(per):
-                    try:
+                try:
+                    if chunks is not None:
+                        state = chunks.advance(state, step * h, per)
+                        step += per
+                    for _ in range(per if chunks is None else 0):
                         state = integ.advance(state, step * h, h)
-                    except StepFailure as fail:
-                        t1 = (step + 1) * h
-                        tried = (f"nor with the step halved {max_halvings} times (the last try, {fail.h:.3g} s "
-                                 f"from t = {fail.t0:.6g} s, failed too)" if max_halvings else
-                                 "and halving the step was not allowed (max_halvings=0)")
-                        raise SolverError(f"generalized-alpha: Newton did not converge in the step to t = {t1:.6g} s "
-                                          f"(dt = {h:.3g} s) even with a fresh Jacobian, {tried}; try a smaller dt "
-                                          "or a smaller rho_inf") from None
-                    step += 1
-                    record(step * h)
+                        step += 1
+                        record(step * h)
+                except StepFailure as fail:
+                    t1 = (math.floor(fail.t0 / h + 1e-9) + 1) * h
+                    tried = (f"nor with the step halved {max_halvings} times (the last try, {fail.h:.3g} s "
+                             f"from t = {fail.t0:.6g} s, failed too)" if max_halvings else
+                             "and halving the step was not allowed (max_halvings=0)")
+                    raise SolverError(f"generalized-alpha: Newton did not converge in the step to t = {t1:.6g} s "
+                                      f"(dt = {h:.3g} s) even with a fresh Jacobian, {tried}; try a smaller dt "
+                                      "or a smaller rho_inf") from None
                 x, z = integ.layout(state)
                 run.xs.append(x)
                 run.zs.append(z)
@@ -221,7 +229,8 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
 def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: float = 0.9,
                       variant: str = "stabilized", tol: float = 1e-10, max_iterations: int = 20, n_out: int = 200,
                       progress: bool = True, expand: bool = False, max_halvings: int = 4,
-                      multipliers: str = "kkt", monitor=None, handlers=None) -> SimulationResult:
+                      multipliers: str = "kkt", monitor=None, handlers=None,
+                      compiled: bool | None = None) -> SimulationResult:
     """Simulate ``model`` from 0 to ``t_end`` seconds by the generalized-alpha method (fixed step).
 
     Parameters
@@ -277,6 +286,13 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
         with wheel/rail contacts (:func:`symcat.simulation.integrate_model` attaches them): the
         run then goes through the event-stepping driver, generalized-alpha steps inside its
         calls (:mod:`.alpha_events`), with outputs every ``t_end / n_out``.
+    compiled : bool, optional
+        Without ``monitor`` and ``handlers``, run the steps as compiled C, many per call
+        (:mod:`.alpha_chunk`: the same steps to the Newton tolerance; models of wires, bodies
+        and joints whose element windows do not move); with ``handlers``, compile the rest of
+        each step. The code is compiled once per model and cached. None (default): compiled
+        if cached or if the run has at least :data:`COMPILE_STEPS` steps; True: compiled now if
+        not cached; False: every step evaluated from Python.
 
     Returns
     -------
@@ -301,7 +317,7 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
     try:
         with serial_blas():
             run = integrate_alpha(model, t_end, dt, rho_inf, variant, tol, max_iterations, n_out, progress, expand,
-                                  max_halvings, monitor, handlers)
+                                  max_halvings, monitor, handlers, compiled)
     except SolverError as err:
         if isinstance(err.partial, AlphaRun):
             err.partial = err.partial.result(wall0, multipliers)

@@ -1,0 +1,353 @@
+"""Generalized-alpha steps run in compiled C, many per call: the plain steps of a run without
+events or per-step monitor (:func:`.generalized_alpha.integrate_alpha`).
+
+Why: on a small model (a cable pendulum of a hundred coordinates, a wire under a moving load)
+a step's arithmetic takes tens of microseconds, and the Python around each Newton iteration
+of :func:`.alpha_step.solve_step` (residual calls, SciPy factorizations and solves,
+bookkeeping) several hundred; stepped from Python, symcat was several times slower than a
+compiled code. Here the same steps (unknowns, scaled residual, modified Newton iteration and
+its convergence test) are one CasADi function of up to :data:`MAX_STEPS` steps, generated to
+C and compiled once per model (cached on disk like the models' DAEs,
+:func:`symcat.codegen.model_dae.compiled_library`):
+
+- the residual is :meth:`.alpha_step.StepEquations._rows` of the whole model, with the
+  sliding and contact points' element windows over their whole wires (the code must not
+  depend on where a point is), expanded to scalar operations;
+- the iteration matrix is the step's exact Jacobian, factorized in the code as a band (the
+  wires, ordered by reverse Cuthill-McKee) with a dense border (bodies, arc lengths,
+  multipliers: :class:`.bordered_band.BorderedBand`), kept across steps and factorized afresh
+  at the current iterate when the iteration contracts slower than
+  :data:`~.alpha_step.SLOW_CONTRACTION`, as :func:`~.alpha_step.solve_step` does;
+- a step that fails even with a fresh matrix (divergence, :data:`MAX_ITERATIONS`, a
+  non-finite update) ends the call; that step is then taken by
+  :meth:`.alpha_integrator.Integrator.advance` (its own matrices, halving) and the compiled
+  steps resume after it.
+
+The results are the Python steps' to the Newton tolerance. Models with wheel/rail contacts
+(events), a border of more than :data:`MAX_BORDER` unknowns or a band of more than
+:data:`MAX_BAND_ENTRIES` entries (a line: its steps' Python overhead is small against its
+arithmetic) keep the Python steps."""
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+
+from ..codegen.library import BufferedFunction, merged, symbolic_kernels, write_functions_c
+from ..errors import CompilerError
+from .alpha_bulk import bulk_rows, step_data
+from .alpha_integrator import Integrator, State
+from .alpha_step import SLOW_CONTRACTION, StepEquations
+from .bordered_band import BorderedBand
+
+log = logging.getLogger(__name__)
+
+#: Steps per compiled call at most (the code holds one call of the step per step; a call with
+#: fewer skips the others, so one library serves every step size and output interval).
+MAX_STEPS = 32
+#: Newton iterations of a compiled step before it counts as failed (the iteration matrix is
+#: factorized afresh at most :data:`ROUNDS` - 1 times in a step).
+MAX_ITERATIONS = 18
+ROUNDS = 3
+#: Unknowns besides the wires' at most (the border's Schur complement is dense).
+MAX_BORDER = 60
+#: Operations of the wires' band factorization at most, ``n_b (b + 1)^2`` (straight-line code:
+#: the compiler's time grows with it; a line's steps keep Python, whose overhead is small
+#: against their arithmetic).
+MAX_BAND_WORK = 60_000
+
+#: This module's and the factorization's code, part of the compiled library's key.
+_SOURCE = Path(__file__).read_bytes() + (Path(__file__).parent / "bordered_band.py").read_bytes()
+
+
+class CompiledSteps:
+    """The compiled steps of one run of ``integ`` with steps of ``h`` (s), at most ``per`` per
+    call (one output interval). The code is generated, or loaded from the cache, at the first
+    call; :attr:`disabled` says why a model's steps stay in Python (None: they do not)."""
+
+    def __init__(self, integ: Integrator, h: float, per: int, build: bool = True):
+        self.integ, self.h, self.per, self.build = integ, h, min(int(per), MAX_STEPS), build
+        self._fn = None
+        self._factor = None  # the iteration matrix's factor the compiled steps carry
+        self._renew = True  # factorize it at the next call's first step
+        self._scale = None
+        self.disabled = unsupported(integ.model)
+
+    def advance(self, s: State, t0: float, n: int) -> State:
+        """The state ``n`` steps of :attr:`h` after ``s`` at ``t0``."""
+        integ, h = self.integ, self.h
+        k = 0
+        while k < n:
+            renew = self._renew
+            if self.disabled is None and self._ready(s, t0 + k * h):
+                done, s, iterations = self._call(s, t0 + k * h, n - k)
+                integ.stats["steps"] += done
+                integ.stats["compiled_steps"] = integ.stats.get("compiled_steps", 0) + done
+                integ.stats["newton_iterations"] += iterations
+                k += done
+                self._windows(s)
+                if k == n or done or not renew:
+                    continue  # all done, or a failure that a call with a fresh matrix may pass
+            if k < n:  # no compiled steps here, or failed on a fresh matrix: one Python step
+                s = integ.advance(s, t0 + k * h, h)
+                self._renew = True
+                k += 1
+        integ.stats["nsteps"] = integ.stats["steps"]
+        return s
+
+    def _ready(self, s: State, t: float) -> bool:
+        """Whether the compiled steps can run (building or loading them at the first call)."""
+        if self._fn is not None:
+            return True
+        integ, st = self.integ, self.integ.stepper
+        if st.mass_scale is None:  # the scale of the multipliers' tolerance (a Python factorization)
+            p = integ.data(s, t, self.h)
+            st.factorize(integ.predictor(s, p, self.h), p)
+        try:
+            graph = _residual(st)
+            layout = _layout(st)
+            work = layout.n_b * (layout.bw + 1) ** 2
+            if layout.n_r > MAX_BORDER or work > MAX_BAND_WORK:
+                self.disabled = (f"{layout.n_r} unknowns besides the wires' (at most {MAX_BORDER}), a band "
+                                 f"factorization of {work} operations (at most {MAX_BAND_WORK})")
+                return False
+            self._fn = _compiled(st, self.integ.coef, graph, self.build)
+            if self._fn is None:
+                self.disabled = "not compiled yet, and a short run (see generalized_alpha's compiled)"
+                return False
+        except (RuntimeError, CompilerError) as exc:  # no compiler, or a kernel without SX form
+            log.warning("generalized-alpha steps could not be compiled (%s); stepping in Python", exc)
+            self.disabled = str(exc)
+            return False
+        self._factor = np.zeros(layout.size)
+        self._scale = np.full(st.n_y, integ.tol)
+        self._scale[st.n_u : st.n_u + st.n_c] *= st.mass_scale
+        return True
+
+    def _call(self, s: State, t: float, n: int):
+        """``(steps done, state after them, Newton iterations)`` of one compiled call of at most
+        ``min(n, per)`` steps from ``s`` at ``t``."""
+        per, h = self.per, self.h
+        x, self._factor, its, factorizations = self._fn.nonzeros(
+            self._pack(s), t + h * np.arange(MAX_STEPS), h, min(n, per), self._factor, float(self._renew), self._scale)
+        self.integ.stepper.bulk.factorizations += int(factorizations[0])
+        failed = np.flatnonzero(its <= 0)
+        done = min(int(failed[0]) if failed.size else per, n)
+        self._renew = done < min(n, per)  # a failure: renew the matrix where the next call starts
+        if done:
+            s = self._unpack(x)
+        return done, s, int(its[:done].sum())
+
+    def _windows(self, s: State) -> None:
+        """Move the element windows with their points (for the Python steps' equations)."""
+        self.integ.move_windows(s)
+
+    # --- the packed state: u v v_dot a lam sc a_prev lam_prev sc_prev h failed --------------
+    def _pack(self, s: State) -> np.ndarray:
+        a_prev, lam_prev, sc_prev = s.prev
+        return np.concatenate([s.u, s.v, s.v_dot, s.a, s.lam, s.sc, a_prev, lam_prev, sc_prev, [s.h, 0.0]])
+
+    def _unpack(self, x: np.ndarray) -> State:
+        st = self.integ.stepper
+        n_u, n_c, n_sc = st.n_u, st.n_c, st.n_sc
+        cuts = np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc])
+        u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev = (x[i:j] for i, j in zip(cuts[:-1], cuts[1:]))
+        return State(u, v, v_dot, a, lam, sc, (a_prev, lam_prev, sc_prev), float(x[cuts[-1]]))
+
+
+def unsupported(model) -> str | None:
+    """Why ``model``'s steps cannot run compiled, or None: wheel/rail contacts (events), or
+    element windows that move (the code would hold every element of a long wire)."""
+    if model.wheelrail:
+        return "wheel/rail contacts"
+    if model.windows_move():
+        return f"element windows that move (wires of more than {model.window_size} elements under a point)"
+    return None
+
+
+def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> BufferedFunction | None:
+    """The compiled function of :func:`_chunk_function`, from the cache or (``build``)
+    generated now; None if not cached and not ``build``."""
+    from ..codegen.model_dae import compiled_library
+
+    per = MAX_STEPS
+    settings = (per, MAX_ITERATIONS, ROUNDS, SLOW_CONTRACTION, st.variant, coef.rho_inf)
+    # The residual over the compiled kernels names the model; the rest of the code follows
+    # from this module's source and the settings.
+    key = graph.serialize().encode() + repr(settings).encode() + b"|alpha_chunk|" + _SOURCE
+
+    def write(folder):
+        with symbolic_kernels():
+            fn = _chunk_function(st, coef, per, _residual(st))
+        return write_functions_c([fn], "alpha_chunk", folder)
+
+    path = compiled_library("alpha_chunk", key, write, mode="now", build=build)
+    return None if path is None else BufferedFunction(ca.external("alpha_chunk", str(path)))
+
+
+def _residual(st: StepEquations) -> ca.Function:
+    """The whole step's residual ``(y, p) -> (rows, shift)`` (see
+    :meth:`.alpha_step.StepEquations._rows`) with every element window over its whole wire."""
+    y, p = ca.MX.sym("y", st.n_y), ca.MX.sym("p", 3 * st.n_u + 4)
+    model = st.form.model
+    saved = [sl.window for sl in model.windowed()]
+    try:
+        for sl in model.windowed():
+            sl.window = (0, len(sl.element_start) - 1)
+        rows, shift = st._rows(y, p, ca.MX.sym("mode", 0), part="all")
+    finally:
+        for sl, window in zip(model.windowed(), saved):
+            sl.window = window
+    return ca.Function("alpha_chunk_residual", [y, p], [rows, shift])
+
+
+def _chunk_function(st: StepEquations, coef, per: int, graph: ca.Function) -> ca.Function:
+    """``alpha_chunk(x0, t (per), h, n, factor, renew, scale) -> (x, factor, iterations (per),
+    factorizations)``: up to ``n`` steps of ``h`` from the packed state ``x0`` at the times
+    ``t``, with the iteration matrix's ``factor`` (factorized at the first step's predictor if
+    ``renew``); ``x`` is the state after the last step that converged and ``factor`` the one
+    the steps ended with; a step's iterations are 0 (not taken: past ``n`` or after a failure)
+    or -1 (failed)."""
+    n_u, n_c, n_sc, n_y = st.n_u, st.n_c, st.n_sc, st.n_y
+    n_x = 5 * n_u + 2 * (n_c + n_sc) + 2
+    y, p = ca.MX.sym("y", n_y), ca.MX.sym("p", 3 * n_u + 4)
+    # Expanded to scalar operations, shared subexpressions merged: as an MX graph the code
+    # spends most of its time on sparse bookkeeping (3 to 5 times the arithmetic here).
+    residual = merged(graph.expand())
+    rows_of = ca.Function("alpha_chunk_rows", [y, p], [residual(y, p)[0]])
+    shift_of = (ca.Function("alpha_chunk_shift", [y, p], [residual(y, p)[1]])
+                if st.variant == "stabilized" and n_c else None)
+    # The Jacobian from the graph (the wires' stiffness kernels): expanded it is some 30 times
+    # the residual's code, compiles for minutes and saves little (a factorization is rare).
+    layout = _layout(st)
+    jac = ca.project(_jacobian(st, residual)(y, p), layout.pattern)
+    factor = ca.MX.sym("factor", layout.size)
+    factorize = ca.Function("alpha_chunk_factorize", [y, p, factor], [layout.factorize(_nonzeros(jac))])
+    keep_factor = ca.Function("alpha_chunk_keep_factor", [y, p, factor], [factor])
+    refresh = ca.Function.if_else("alpha_chunk_refresh", factorize, keep_factor)
+    rhs = ca.MX.sym("rhs", n_y)
+    solve = ca.Function("alpha_chunk_solve", [factor, rhs], [layout.solve(factor, rhs)])
+
+    # One Newton iteration: (y, previous error, status, count, fresh) -> (y, error, status,
+    # count); status 0 running, 1 converged, 2 failed, 3 slow (wants a fresh matrix): the
+    # tests of solve_step. fresh: the matrix was factorized in this step.
+    scale = ca.MX.sym("scale", n_y)
+    prev, status, count, fresh = ca.MX.sym("prev"), ca.MX.sym("status"), ca.MX.sym("count"), ca.MX.sym("fresh")
+    dy = -solve(factor, rows_of(y, p))
+    err = ca.mmax(ca.fabs(dy / scale))
+    theta = ca.if_else(prev > 0, err / prev, 0)
+    finite = err < np.inf
+    converged = ca.logic_and(finite, ca.logic_or(
+        ca.logic_and(ca.logic_and(err <= 1, theta < 1), theta / ca.fmax(1 - theta, 1e-300) * err <= 1), err <= 1e-3))
+    slow = ca.logic_and(prev > 0, theta > SLOW_CONTRACTION)
+    diverging = ca.logic_and(fresh > 0, theta >= 1)  # on a fresh matrix: the step fails
+    failed = ca.logic_or(ca.logic_or(ca.logic_not(finite), ca.logic_and(slow, diverging)),
+                         count + 1 >= MAX_ITERATIONS)
+    new_status = ca.if_else(converged, 1, ca.if_else(failed, 2, ca.if_else(slow, 3, 0)))
+    args = [y, prev, status, count, fresh, p, scale, factor]
+    iterate = ca.Function("alpha_chunk_iteration", args, [y + dy, err, new_status, count + 1])
+    keep = ca.Function("alpha_chunk_keep", args, [y, prev, status, count])
+    newton = ca.Function.if_else("alpha_chunk_newton", keep, iterate)
+
+    # One step: (packed state, factor, renew, t0, h, index, n, scale) -> (state, factor,
+    # iterations, factorizations)
+    xk, t0, h, index, n = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h"), ca.MX.sym("k"), ca.MX.sym("n")
+    renew = ca.MX.sym("renew")
+    parts = ca.vertsplit(xk, np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc, 1, 1]).tolist())
+    u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev, h_prev, was_failed = parts
+    c = coef
+    bh2 = c.beta * h * h
+    p_k = ca.vertcat(u + h * v + h * h * (0.5 - c.beta) * a, v + h * (1 - c.gamma) * a,
+                     (c.alpha_m * a - c.alpha_f * v_dot) / (1 - c.alpha_f), t0 + h, bh2, c.gamma * h,
+                     (1 - c.alpha_m) / (1 - c.alpha_f))
+    ratio = h / h_prev
+    y_k = ca.vertcat(p_k[:n_u] + bh2 * (a + ratio * (a - a_prev)), bh2 * (lam + ratio * (lam - lam_prev)),
+                     ca.MX(n_y - n_u - n_c - n_sc, 1), sc + ratio * (sc - sc_prev))
+    active = ca.logic_and(index < n, was_failed == 0)
+    wanted = ca.logic_and(active, renew)
+    f_k = refresh(wanted, y_k, p_k, factor)
+    fr, factorizations = wanted, wanted
+    e, stat, cnt = ca.MX(0), ca.if_else(active, 0, 1), ca.MX(0)  # an inactive step: "converged" untouched
+    for round_ in range(ROUNDS):
+        for _ in range(MAX_ITERATIONS // ROUNDS):
+            y_k, e, stat, cnt = newton(stat != 0, y_k, e, stat, cnt, fr, p_k, scale, f_k)
+        wanted = stat == 3
+        if round_ < ROUNDS - 1:  # slow: a fresh matrix at the current iterate, and on
+            f_k = refresh(wanted, y_k, p_k, f_k)
+            fr, factorizations = ca.logic_or(fr, wanted), factorizations + wanted
+            stat, e = ca.if_else(wanted, 0, stat), ca.if_else(wanted, 0, e)
+    ok = ca.logic_and(active, stat == 1)
+    u_pred, v_pred, b, _, _, gh, cm = step_data(p_k, n_u)
+    a_new = (y_k[:n_u] - u_pred - (shift_of(y_k, p_k) if shift_of is not None else 0)) / bh2
+    stepped = ca.vertcat(y_k[:n_u], v_pred + gh * a_new, cm * a_new + b, a_new, y_k[n_u : n_u + n_c] / bh2,
+                         y_k[n_y - n_sc :], a, lam, sc, h, 0)
+    new_x = ca.if_else(ok, stepped, ca.vertcat(xk[:-1], ca.logic_or(was_failed, active)))
+    iterations = ca.if_else(ok, cnt, ca.if_else(active, -1, 0))
+    step = ca.Function("alpha_chunk_step", [xk, factor, renew, t0, h, index, n, scale],
+                       [new_x, f_k, iterations, factorizations])
+    skip = ca.Function("alpha_chunk_skip", [xk, factor, renew, t0, h, index, n, scale], [xk, factor, 0, 0])
+    step = ca.Function.if_else("alpha_chunk_step_or_skip", step, skip)
+    # A loop of calls, not mapaccum: its code copies the inputs common to the steps once per
+    # step, which cost more than the steps.
+    x0, times = ca.MX.sym("x0", n_x), ca.MX.sym("t", per)
+    x, f_out, counts, total = x0, factor, [], 0
+    for k in range(per):  # a failed step leaves the state as it was: x is the last good one
+        x, f_out, count, fk = step(k < n, x, f_out, renew if k == 0 else 0, times[k], h, k, n, scale)
+        counts.append(count)
+        total += fk
+    return ca.Function("alpha_chunk", [x0, times, h, n, factor, renew, scale],
+                       [x, f_out, ca.vertcat(*counts), total])
+
+
+def _jacobian(st: StepEquations, residual: ca.Function) -> ca.Function:
+    """``(y, p) -> J``: the iteration matrix, the step's Jacobian but for the wires' own block,
+    which is the bulk's (:func:`.alpha_bulk.bulk_rows`: elements, Rayleigh damping, force
+    elements between nodes), without what bodies, joints and contacts add there.
+
+    With a point's kernels over a whole wire (:func:`_residual`) those additions (a joint's
+    multiplier times its curvature, a contact's stiffness) couple every element's coordinates
+    with every other's in structure, through the point's element selection, although in value
+    only the element holding the point has them: differentiated as they stand they made a
+    dense block as large as the wire. Left out, the matrix is that of the modified Newton
+    iteration it already is (a joint's term is a fraction of a per cent of the wires'
+    stiffness; a stiff penalty contact slows the iteration, which then falls back to Python
+    steps)."""
+    n_b, n_y, n_u = st.bulk.n_b, st.n_y, st.n_u
+    # the border in scalar operations, differentiated where its entries depend on the unknowns
+    # (a derivative of the residual's call in all directions would be the whole residual's
+    # code ten times over)
+    y_s, p_s = residual.sx_in()
+    rows_s = residual(y_s, p_s)[0]
+    border = merged(ca.Function("alpha_chunk_border", [y_s, p_s], [ca.jacobian(rows_s, y_s[n_b:]),
+                                                                     ca.jacobian(rows_s[n_b:], y_s[:n_b])]))
+    y, p = ca.MX.sym("y", n_y), ca.MX.sym("p", 3 * n_u + 4)
+    j_cols, j_rows = border(y, p)
+    shift_b = ca.MX.sym("shift_b", n_b)
+    y_b = ca.MX.sym("y_b", n_b)
+    bulk = ca.Function("alpha_chunk_bulk_jacobian", [y_b, p, shift_b],
+                       [ca.jacobian(bulk_rows(st.form, n_b, n_u, y_b, p, shift_b), y_b)])
+    j_bb = bulk(y[:n_b], p, residual(y, p)[1][:n_b]) if n_b else ca.MX(0, 0)
+    jac = ca.blockcat([[j_bb, j_cols[:n_b, :]], [j_rows, j_cols[n_b:, :]]])
+    return ca.Function("alpha_chunk_jacobian", [y, p], [jac])
+
+
+def _layout(st: StepEquations) -> BorderedBand:
+    """The iteration matrix's :class:`BorderedBand`: the wires' block in the bulk's pattern,
+    the rows and columns of the other unknowns dense."""
+    n_b, n = st.bulk.n_b, st.n_y
+    rows, cols = [], []
+    if n_b:
+        b_colind, b_row = st.bulk.jacobian.function.sparsity_out(0).get_ccs()
+        rows += list(b_row)
+        cols += np.repeat(np.arange(n_b), np.diff(b_colind)).tolist()
+    border = np.argwhere((np.arange(n)[:, None] >= n_b) | (np.arange(n)[None, :] >= n_b))
+    rows += border[:, 0].tolist()
+    cols += border[:, 1].tolist()
+    return BorderedBand(ca.Sparsity.triplet(n, n, rows, cols), n_b)
+
+
+def _nonzeros(m: ca.MX) -> ca.MX:
+    """The nonzeros of ``m`` as a column (in its CCS order)."""
+    return ca.sparsity_cast(m, ca.Sparsity.dense(m.nnz(), 1))

@@ -1,0 +1,166 @@
+"""Sparse linear algebra as CasADi graphs for compiled code: the LU factorization of a matrix
+that is a band plus a dense border, and its solve.
+
+A model of wires with a few bodies, joints or contacts has a step matrix whose wire block,
+ordered by reverse Cuthill-McKee, is a narrow band (half-bandwidth ~12 for cable elements);
+the other unknowns (a body, an arc length, multipliers) form a dense border of a few rows and
+columns. Factorized as
+
+    [B  E]   B = L U (band, no pivoting)
+    [F  D]   S = D - F B^-1 E (dense, small: solved through its QR),
+
+the cost is O(n b^2) and every index is known when the code is generated: the straight-line
+code of the band has no sparse bookkeeping at run time. Without pivoting the band must not
+need it: the wires' block of a generalized-alpha step is ``c_m M + gamma h D + beta h^2 K``
+plus small constraint terms, positive definite in practice; a zero or tiny pivot shows as a
+non-finite solution, which the caller treats as a failed step.
+"""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+
+class BorderedBand:
+    """The layout of a square sparsity pattern ``[B E; F D]`` (``B`` the first ``n_b`` unknowns)
+    as a band after a reverse Cuthill-McKee ordering of ``B`` plus a dense border, and the
+    graphs of its factorization and solve.
+
+    Parameters
+    ----------
+    sparsity : casadi.Sparsity
+        Of the whole matrix (n x n).
+    n_b : int
+        Size of the banded block.
+    """
+
+    def __init__(self, sparsity: ca.Sparsity, n_b: int):
+        n = sparsity.size1()
+        self.n, self.n_b, self.n_r = n, n_b, n - n_b
+        self.pattern = sparsity
+        colind, row = sparsity.get_ccs()
+        rows = np.array(row, int)
+        cols = np.repeat(np.arange(n), np.diff(colind))
+        self.nnz = rows.size
+        in_b = (rows < n_b) & (cols < n_b)
+        pattern = csr_matrix((np.ones(in_b.sum()), (rows[in_b], cols[in_b])), shape=(n_b, n_b))
+        pattern = pattern + pattern.T + csr_matrix(np.eye(n_b)) if n_b else pattern
+        self.perm = reverse_cuthill_mckee(pattern.tocsr(), symmetric_mode=True).astype(int) if n_b else np.zeros(0, int)
+        where = np.empty(n_b, int)
+        where[self.perm] = np.arange(n_b)
+        i, j = where[rows[in_b]], where[cols[in_b]]
+        self.bw = int(np.max(np.abs(i - j))) if i.size else 0
+        w = 2 * self.bw + 1
+        # Gathers from the matrix's nonzeros (index nnz: a zero) into the band (row-major,
+        # a[i, j] at i * w + j - i + bw), the border E (n_b x n_r), F (n_r x n_b) and D.
+        zero = self.nnz
+        self.band_from = np.full(n_b * w, zero)
+        self.band_from[i * w + j - i + self.bw] = np.flatnonzero(in_b)
+        self.e_from = np.full((n_b, self.n_r), zero)
+        self.f_from = np.full((self.n_r, n_b), zero)
+        self.d_from = np.full((self.n_r, self.n_r), zero)
+        e = (rows < n_b) & (cols >= n_b)
+        self.e_from[where[rows[e]], cols[e] - n_b] = np.flatnonzero(e)
+        f = (rows >= n_b) & (cols < n_b)
+        self.f_from[rows[f] - n_b, where[cols[f]]] = np.flatnonzero(f)
+        d = (rows >= n_b) & (cols >= n_b)
+        self.d_from[rows[d] - n_b, cols[d] - n_b] = np.flatnonzero(d)
+        self.band_entries = n_b * w
+        # the factor: LU of the band, X = B^-1 E, F, S^-1
+        self.size = n_b * w + 2 * n_b * self.n_r + self.n_r**2
+
+    # --- graphs -----------------------------------------------------------------------------
+    def factorize(self, nonzeros: ca.MX) -> ca.MX:
+        """The factor (a vector of :attr:`size`) of the matrix with the given nonzeros (in the
+        CCS order of the pattern)."""
+        n_b, n_r = self.n_b, self.n_r
+        values = ca.vertcat(nonzeros, 0)
+
+        def gather(index):
+            return values[index.ravel(order="F").tolist()]
+
+        present = self.band_from != self.nnz
+        lu = _band_lu(n_b, self.bw, present)(gather(self.band_from)) if n_b else ca.MX(0, 1)
+        if not n_r:
+            return lu
+        e = ca.reshape(gather(self.e_from), n_b, n_r)
+        f = ca.reshape(gather(self.f_from), n_r, n_b)
+        d = ca.reshape(gather(self.d_from), n_r, n_r)
+        x = _band_solve(n_b, self.bw).map(n_r)(lu, e) if n_b else ca.MX(0, n_r)
+        s = d - ca.mtimes(f, x)
+        s_inv = ca.solve(s, ca.MX.eye(n_r), "qr")
+        return ca.vertcat(lu, ca.vec(x), ca.vec(f), ca.vec(s_inv))
+
+    def solve(self, factor: ca.MX, rhs: ca.MX) -> ca.MX:
+        """``A^-1 rhs`` from :meth:`factorize`'s factor."""
+        n_b, n_r, w = self.n_b, self.n_r, 2 * self.bw + 1
+        lu = factor[: n_b * w]
+        perm = self.perm.tolist()
+        z = _band_solve(n_b, self.bw)(lu, rhs[perm]) if n_b else ca.MX(0, 1)
+        if n_r:
+            at = n_b * w
+            x = ca.reshape(factor[at : at + n_b * n_r], n_b, n_r)
+            f = ca.reshape(factor[at + n_b * n_r : at + 2 * n_b * n_r], n_r, n_b)
+            s_inv = ca.reshape(factor[at + 2 * n_b * n_r :], n_r, n_r)
+            y_r = ca.mtimes(s_inv, rhs[n_b:] - ca.mtimes(f, z))
+            z = z - ca.mtimes(x, y_r)
+        else:
+            y_r = ca.MX(0, 1)
+        back = np.empty(n_b, int)
+        back[self.perm] = np.arange(n_b)
+        return ca.vertcat(z[back.tolist()] if n_b else ca.MX(0, 1), y_r)
+
+
+def _band_lu(n: int, bw: int, present: np.ndarray) -> ca.Function:
+    """``band -> lu``: the LU factors without pivoting of a band matrix (row-major band storage,
+    ``a[i, j]`` at ``i (2 bw + 1) + j - i + bw``; ``present`` marks the entries that can be
+    nonzero), ``L`` unit lower below the diagonal and ``U`` on and above it, in the same
+    storage; straight-line scalar code (structural zeros and their fill-in followed)."""
+    w = 2 * bw + 1
+    band = ca.SX.sym("band", n * w)
+    a = {}
+    for i in range(n):
+        for j in range(max(0, i - bw), min(n, i + bw + 1)):
+            k = i * w + j - i + bw
+            a[(i, j)] = band[k] if present[k] else ca.SX(0)
+    for k in range(n):
+        inv = 1 / a[(k, k)]
+        for i in range(k + 1, min(n, k + bw + 1)):
+            if ca.SX(a[(i, k)]).is_zero():
+                continue
+            lik = a[(i, k)] * inv
+            a[(i, k)] = lik
+            for j in range(k + 1, min(n, k + bw + 1)):
+                if not ca.SX(a[(k, j)]).is_zero():
+                    a[(i, j)] = a[(i, j)] - lik * a[(k, j)]
+    out = []
+    for i in range(n):
+        for j in range(i - bw, i + bw + 1):
+            out.append(a[(i, j)] if 0 <= j < n else ca.SX(0))
+    return ca.Function("band_lu", [band], [ca.vertcat(*out)])
+
+
+def _band_solve(n: int, bw: int) -> ca.Function:
+    """``(lu, b) -> x`` with the factors of :func:`_band_lu`; straight-line scalar code."""
+    w = 2 * bw + 1
+    lu = ca.SX.sym("lu", n * w)
+    b = ca.SX.sym("b", n)
+
+    def at(i, j):
+        return lu[i * w + j - i + bw]
+
+    z = []
+    for i in range(n):  # L z = b
+        acc = b[i]
+        for j in range(max(0, i - bw), i):
+            acc -= at(i, j) * z[j]
+        z.append(acc)
+    x = [None] * n
+    for i in range(n - 1, -1, -1):  # U x = z
+        acc = z[i]
+        for j in range(i + 1, min(n, i + bw + 1)):
+            acc -= at(i, j) * x[j]
+        x[i] = acc / at(i, i)
+    return ca.Function("band_solve", [lu, b], [ca.vertcat(*x)])

@@ -1,0 +1,115 @@
+"""Generalized-alpha steps compiled many to a call (:mod:`symcat.integrate.alpha_chunk`): the
+same steps as from Python, to the Newton tolerance, on wires, bodies and joints; their band and
+border factorization against NumPy; what stays in Python and why."""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+import scipy.sparse as sps
+
+from symcat.assembly.multibody import MultibodyModel
+from symcat.integrate.alpha_chunk import unsupported
+from symcat.integrate.bordered_band import BorderedBand
+from symcat.integrate.generalized_alpha import generalized_alpha
+from symcat.scene import AncfBody, Material, Scene, Section
+from tests.dynamics.test_generalized_alpha import _defaults, _scene_module
+from tests.dynamics.test_sliding import ring
+
+
+def cable_pendulum(n_elements=4):
+    """A 1 m cable pinned at one end, swinging and spinning (the peer bench's problem 4)."""
+    section = Section.from_stiffness(40.0, 7.9577e-5, 1e9)
+    wire = AncfBody.straight("cable", "cable3d", [0, 0, 0], [1.0, 0, 0], n_elements,
+                             Material(E=1e9, rho=8e-3 / section.A), section)
+    wire.pin(0)
+    scene = Scene(gravity=(0.0, -9.81, 0.0))
+    scene.add(wire)
+    model = MultibodyModel(scene)
+    for k in range(wire.n_nodes):
+        model.v0[model.ancf.dofs.node_indices(wire, k)[2]] = -4.0 * wire.q0[k, 0]
+    return model
+
+
+def slider(window=16):
+    module = _scene_module("slider_on_wire")
+    return MultibodyModel(module.build(_defaults(module)), window=window)
+
+
+def _both(make, t_end, dt, **kwargs):
+    return [generalized_alpha(make(), t_end, dt, n_out=20, progress=False, multipliers="integrator",
+                              compiled=compiled, **kwargs) for compiled in (False, True)]
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_band_and_border_solve_as_numpy(seed):
+    """A band (scrambled, so the ordering must find it) with a border whose own block has
+    zeros on its diagonal (multipliers): the factor solves like a dense solve."""
+    rng = np.random.default_rng(seed)
+    n_b, n_r = 30, 4
+    a = np.zeros((n_b + n_r,) * 2)
+    for i in range(n_b):
+        for j in range(max(0, i - 2), min(n_b, i + 3)):
+            a[i, j] = rng.normal()
+        a[i, i] += 8.0
+    order = rng.permutation(n_b)
+    a[:n_b, :n_b] = a[np.ix_(order, order)]
+    a[:n_b, n_b:] = rng.normal(size=(n_b, n_r)) * (rng.random((n_b, n_r)) < 0.5)
+    a[n_b:, :n_b] = a[:n_b, n_b:].T
+    a[n_b:, n_b:] = np.diag([0.0, 1.0, 0.0, 2.0])
+    m = sps.csc_matrix(a)
+    layout = BorderedBand(ca.Sparsity(*m.shape, m.indptr.tolist(), m.indices.tolist()), n_b)
+    assert layout.bw == 2  # the band found again
+    nz, rhs = ca.MX.sym("nz", m.nnz), ca.MX.sym("rhs", n_b + n_r)
+    solve = ca.Function("solve", [nz, rhs], [layout.solve(layout.factorize(nz), rhs)])
+    b = rng.normal(size=n_b + n_r)
+    assert np.abs(np.array(solve(m.data, b)).ravel() - np.linalg.solve(a, b)).max() < 1e-12
+
+
+def test_compiled_steps_of_a_spinning_cable_match_the_python_steps(record_property):
+    """Wires only: the compiled steps refactorize their band in the code when the iteration
+    slows, as the Python steps do; the two runs agree to the Newton tolerance."""
+    python, compiled = _both(cable_pendulum, 0.5, 1e-3, rho_inf=0.8, tol=1e-10)
+    apart = np.abs(compiled.q - python.q).max()
+    record_property("apart_m", apart)
+    assert compiled.stats["compiled_steps"] == compiled.stats["steps"] == 500
+    assert "compiled_steps" not in python.stats
+    assert apart < 1e-7
+    assert compiled.stats["factorizations"] >= 1
+
+
+def test_compiled_steps_of_a_body_on_a_sliding_joint_match_the_python_steps(record_property):
+    """A body, its sliding joint's arc length and multipliers in the border of the matrix."""
+    python, compiled = _both(slider, 0.2, 1e-3, rho_inf=0.9, tol=1e-10)
+    apart = np.abs(compiled.q - python.q).max()
+    s_apart = np.abs(compiled.s_m - python.s_m).max()
+    record_property("apart_m", [apart, s_apart])
+    assert compiled.stats["compiled_steps"] == 200
+    assert apart < 1e-7 and s_apart < 1e-7
+    assert np.abs(compiled.multipliers - python.multipliers).max() < 1e-5 * np.abs(python.multipliers).max()
+
+
+def test_a_bead_crossing_element_ends_in_the_compiled_steps(record_property):
+    """No free wire coordinate (a clamped ring: the matrix is all border); the bead crosses
+    element ends inside the compiled calls, whose code holds the whole ring."""
+    python, compiled = _both(lambda: ring(8, window=8), 0.4, 1e-3, rho_inf=0.9, tol=1e-10)
+    assert compiled.s_m[-1, 0] - compiled.s_m[0, 0] > 2.0 * np.radians(350.0) / 8  # two element ends
+    assert compiled.stats["compiled_steps"] == 400
+    assert np.abs(compiled.s_m - python.s_m).max() < 1e-8
+
+
+def test_steps_the_compiled_code_cannot_take_are_taken_in_python():
+    """Steps so large that Newton fails even on a fresh matrix: those steps (halved) are the
+    Python steps', the others compiled, and the run ends where the Python run ends."""
+    python, compiled = _both(cable_pendulum, 0.2, 5e-3, rho_inf=0.8, tol=1e-8)
+    assert 0 < compiled.stats["compiled_steps"] <= compiled.stats["steps"]
+    assert np.abs(compiled.q[-1] - python.q[-1]).max() < 1e-2  # both at the step's error
+    assert np.isfinite(compiled.q).all()
+
+
+def test_what_stays_in_python_says_why():
+    assert "windows that move" in unsupported(slider(window=2))
+    assert unsupported(slider()) is None
+    model = cable_pendulum()
+    run = generalized_alpha(model, 0.01, 1e-3, n_out=2, progress=False, compiled=False)
+    assert "compiled_steps" not in run.stats
