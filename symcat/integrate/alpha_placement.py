@@ -13,6 +13,11 @@ from __future__ import annotations
 import numpy as np
 
 
+def weighted_sum(index: np.ndarray, weights: np.ndarray, size: int) -> np.ndarray:
+    """``bincount(index, weights, minlength=size)``, floats also without terms."""
+    return np.bincount(index, weights, minlength=size) if index.size else np.zeros(size)
+
+
 class Terms:
     """``out = bincount(place, x[source] * weight) + constant``: a vector of ``size`` made of
     weighted entries of another."""
@@ -29,7 +34,7 @@ class Terms:
     def __call__(self, x: np.ndarray) -> np.ndarray:
         if self._copy:
             return x[self.source]
-        return np.bincount(self.place, x[self.source] * self.weight, minlength=self.size) + self.constant
+        return weighted_sum(self.place, x[self.source] * self.weight, self.size) + self.constant
 
 
 class Placement:
@@ -70,8 +75,8 @@ class Placement:
     def residual(self, r_nz: np.ndarray, shift_nz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The rest's residual (n_y) and shift (n_u), dense, from its outputs' nonzeros."""
         (at, row, weight), (s_at, s_row, s_weight) = self._r, self._shift
-        return (np.bincount(row, r_nz[at] * weight, minlength=self.n_y),
-                np.bincount(s_row, shift_nz[s_at] * s_weight, minlength=self.n_u))
+        return (weighted_sum(row, r_nz[at] * weight, self.n_y),
+                weighted_sum(s_row, shift_nz[s_at] * s_weight, self.n_u))
 
     def jacobian(self, values: np.ndarray) -> np.ndarray:
         """The Jacobian's values on :attr:`jac_rows` and :attr:`jac_cols` (duplicates add)."""

@@ -40,7 +40,7 @@ from ..codegen.library import BufferedFunction, symbolic_kernels
 from ..dae.formulation import Formulation
 from ..errors import SolverError
 from .alpha_bulk import Bulk, step_data
-from .alpha_placement import Placement, Terms, csc_pattern, identity, output_maps
+from .alpha_placement import Placement, Terms, csc_pattern, identity, output_maps, weighted_sum
 from .alpha_proxies import Proxies
 from .alpha_rest import compiled_rest, expanded_rest
 
@@ -317,7 +317,7 @@ class StepEquations:
                 rows, cols = np.r_[rows, bulk_rows], np.r_[cols, bulk_cols]
             pattern = placement.cache["csc"] = csc_pattern(rows, cols, n_y)
         place, indices, indptr = pattern
-        jac = sps.csc_matrix((np.bincount(place, data, minlength=indices.size), indices, indptr), shape=(n_y, n_y))
+        jac = sps.csc_matrix((weighted_sum(place, data, indices.size), indices, indptr), shape=(n_y, n_y))
         jac.eliminate_zeros()  # the pattern's structural zeros (open contacts...) would cost the sparse LU
         return jac
 
@@ -367,7 +367,7 @@ class StepEquations:
             self._coupling = (keys, n_t, delta, z_bulk, cap)
             self._prepared = (float(p[3 * self.n_u + 1]), self.mode.copy())
             return
-        delta = np.bincount(flat, data, minlength=k * k).reshape(k, k)
+        delta = weighted_sum(flat, data, k * k).reshape(k, k)
         delta[n_t:, n_t:] -= np.eye(k - n_t)
         z_k = np.eye(k)
         if n_t:
@@ -402,6 +402,8 @@ class StepEquations:
         n_b = self.bulk.n_b
         x = rhs.copy()
         x[:n_b] = self.bulk.solve(rhs[:n_b])
+        if not keys.size:  # wires only
+            return x
         if isinstance(cap, spla.SuperLU):
             w = cap.solve(delta @ x[keys])
         else:  # LAPACK directly: lu_solve's checks cost as much as this small solve
