@@ -37,7 +37,10 @@ def outputs(res, n_out: int) -> np.ndarray:
 def symcat_solve(model, t_end: float, n_out: int, setting: dict, rho: float):
     """``res.q`` of ``model`` over ``t_end`` (s) at ``n_out`` intervals: IDAS for ``{"rtol": ...}``
     (atol = rtol / 100), else generalized-alpha at ``setting["dt"]`` with spectral radius
-    ``setting.get("rho", rho)`` and Newton tolerance ``setting.get("tol", 1e-10)``."""
+    ``setting.get("rho", rho)``, Newton tolerance ``setting.get("tol", 1e-10)`` and compiled
+    steps as ``setting.get("compiled")`` (None: the library's default). Only positions are
+    compared: generalized-alpha keeps its own multipliers (no KKT solve per output), as
+    Exudyn reports its sensors."""
     from symcat.integrate import simulate
     from symcat.integrate.generalized_alpha import generalized_alpha
 
@@ -45,7 +48,8 @@ def symcat_solve(model, t_end: float, n_out: int, setting: dict, rho: float):
         res = simulate(model, t_end, rtol=setting["rtol"], atol=setting["rtol"] * 1e-2, n_out=n_out, progress=False)
     else:
         res = generalized_alpha(model, t_end, setting["dt"], rho_inf=setting.get("rho", rho), n_out=n_out,
-                                progress=False, tol=setting.get("tol", 1e-10))
+                                progress=False, tol=setting.get("tol", 1e-10), multipliers="integrator",
+                                compiled=setting.get("compiled"))
     return outputs(res, n_out)
 
 

@@ -10,23 +10,24 @@ its convergence test) are one CasADi function of up to :data:`MAX_STEPS` steps, 
 C and compiled once per model (cached on disk like the models' DAEs,
 :func:`symcat.codegen.model_dae.compiled_library`):
 
-- the residual is :meth:`.alpha_step.StepEquations._rows` of the whole model, with the
-  sliding and contact points' element windows over their whole wires (the code must not
-  depend on where a point is), expanded to scalar operations;
-- the iteration matrix is the step's exact Jacobian, factorized in the code as a band (the
-  wires, ordered by reverse Cuthill-McKee) with a dense border (bodies, arc lengths,
-  multipliers: :class:`.bordered_band.BorderedBand`), kept across steps and factorized afresh
-  at the current iterate when the iteration contracts slower than
-  :data:`~.alpha_step.SLOW_CONTRACTION`, as :func:`~.alpha_step.solve_step` does;
+- the residual is the wires' rows and the rest's (:mod:`.alpha_chunk_residual`), the rest on
+  whole-wire windows or, when windows move, on a proxy element of each wire filled at run time
+  with the element holding the point;
+- the iteration matrix is the step's Jacobian (but for what a point adds to the wires' own
+  block), factorized in the code as a band (the wires, ordered by reverse Cuthill-McKee) with a
+  dense border (bodies, arc lengths, multipliers: :class:`.bordered_band.BorderedBand`), kept
+  across steps; when the iteration contracts slower than
+  :data:`~.alpha_step.SLOW_CONTRACTION` its border is renewed at the current iterate, then the
+  whole matrix, as :func:`~.alpha_step.solve_step` prepares the rest, then refactorizes;
 - a step that fails even with a fresh matrix (divergence, :data:`MAX_ITERATIONS`, a
   non-finite update) ends the call; that step is then taken by
   :meth:`.alpha_integrator.Integrator.advance` (its own matrices, halving) and the compiled
   steps resume after it.
 
 The results are the Python steps' to the Newton tolerance. Models with wheel/rail contacts
-(events), a border of more than :data:`MAX_BORDER` unknowns or a band of more than
-:data:`MAX_BAND_ENTRIES` entries (a line: its steps' Python overhead is small against its
-arithmetic) keep the Python steps."""
+(events), windows that move without proxy elements, a border of more than :data:`MAX_BORDER`
+unknowns or a band factorization of more than :data:`MAX_BAND_WORK` operations (a line: its
+steps' Python overhead is small against its arithmetic) keep the Python steps."""
 from __future__ import annotations
 
 import logging
@@ -35,9 +36,10 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
-from ..codegen.library import BufferedFunction, merged, symbolic_kernels, write_functions_c
+from ..codegen.library import BufferedFunction, symbolic_kernels, write_functions_c
 from ..errors import CompilerError
-from .alpha_bulk import bulk_rows, step_data
+from .alpha_bulk import step_data
+from .alpha_chunk_residual import ChunkResidual
 from .alpha_integrator import Integrator, State
 from .alpha_step import SLOW_CONTRACTION, StepEquations
 from .bordered_band import BorderedBand
@@ -59,7 +61,8 @@ MAX_BORDER = 60
 MAX_BAND_WORK = 60_000
 
 #: This module's and the factorization's code, part of the compiled library's key.
-_SOURCE = Path(__file__).read_bytes() + (Path(__file__).parent / "bordered_band.py").read_bytes()
+_SOURCE = b"".join((Path(__file__).parent / name).read_bytes()
+                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "bordered_band.py", "alpha_proxies.py"))
 
 
 class CompiledSteps:
@@ -73,7 +76,7 @@ class CompiledSteps:
         self._factor = None  # the iteration matrix's factor the compiled steps carry
         self._renew = True  # factorize it at the next call's first step
         self._scale = None
-        self.disabled = unsupported(integ.model)
+        self.disabled = unsupported(integ)
 
     def advance(self, s: State, t0: float, n: int) -> State:
         """The state ``n`` steps of :attr:`h` after ``s`` at ``t0``."""
@@ -106,7 +109,7 @@ class CompiledSteps:
             p = integ.data(s, t, self.h)
             st.factorize(integ.predictor(s, p, self.h), p)
         try:
-            graph = _residual(st)
+            graph = _graph(ChunkResidual(st))
             layout = _layout(st)
             work = layout.n_b * (layout.bw + 1) ** 2
             if layout.n_r > MAX_BORDER or work > MAX_BAND_WORK:
@@ -157,13 +160,14 @@ class CompiledSteps:
         return State(u, v, v_dot, a, lam, sc, (a_prev, lam_prev, sc_prev), float(x[cuts[-1]]))
 
 
-def unsupported(model) -> str | None:
-    """Why ``model``'s steps cannot run compiled, or None: wheel/rail contacts (events), or
-    element windows that move (the code would hold every element of a long wire)."""
-    if model.wheelrail:
+def unsupported(integ: Integrator) -> str | None:
+    """Why ``integ``'s steps cannot run compiled, or None: wheel/rail contacts (events), or
+    element windows that move without proxy elements."""
+    if integ.model.wheelrail:
         return "wheel/rail contacts"
-    if model.windows_move():
-        return f"element windows that move (wires of more than {model.window_size} elements under a point)"
+    if integ.model.windows_move() and integ.stepper.proxies is None:
+        return ("element windows that move, without proxy elements (see symcat.integrate.alpha_proxies: "
+                "the code would hold every element under a point)")
     return None
 
 
@@ -180,30 +184,20 @@ def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> Buffe
 
     def write(folder):
         with symbolic_kernels():
-            fn = _chunk_function(st, coef, per, _residual(st))
+            fn = _chunk_function(st, coef, per)
         return write_functions_c([fn], "alpha_chunk", folder)
 
     path = compiled_library("alpha_chunk", key, write, mode="now", build=build)
     return None if path is None else BufferedFunction(ca.external("alpha_chunk", str(path)))
 
 
-def _residual(st: StepEquations) -> ca.Function:
-    """The whole step's residual ``(y, p) -> (rows, shift)`` (see
-    :meth:`.alpha_step.StepEquations._rows`) with every element window over its whole wire."""
-    y, p = ca.MX.sym("y", st.n_y), ca.MX.sym("p", 3 * st.n_u + 4)
-    model = st.form.model
-    saved = [sl.window for sl in model.windowed()]
-    try:
-        for sl in model.windowed():
-            sl.window = (0, len(sl.element_start) - 1)
-        rows, shift = st._rows(y, p, ca.MX.sym("mode", 0), part="all")
-    finally:
-        for sl, window in zip(model.windowed(), saved):
-            sl.window = window
-    return ca.Function("alpha_chunk_residual", [y, p], [rows, shift])
+def _graph(residual: ChunkResidual) -> ca.Function:
+    """``(y, p) -> (rows, shift)`` of ``residual``."""
+    y, p = ca.MX.sym("y", residual.n_y), ca.MX.sym("p", 3 * residual.n_u + 4)
+    return ca.Function("alpha_chunk_residual", [y, p], list(residual.rows_and_shift(y, p)))
 
 
-def _chunk_function(st: StepEquations, coef, per: int, graph: ca.Function) -> ca.Function:
+def _chunk_function(st: StepEquations, coef, per: int) -> ca.Function:
     """``alpha_chunk(x0, t (per), h, n, factor, renew, scale) -> (x, factor, iterations (per),
     factorizations)``: up to ``n`` steps of ``h`` from the packed state ``x0`` at the times
     ``t``, with the iteration matrix's ``factor`` (factorized at the first step's predictor if
@@ -213,20 +207,29 @@ def _chunk_function(st: StepEquations, coef, per: int, graph: ca.Function) -> ca
     n_u, n_c, n_sc, n_y = st.n_u, st.n_c, st.n_sc, st.n_y
     n_x = 5 * n_u + 2 * (n_c + n_sc) + 2
     y, p = ca.MX.sym("y", n_y), ca.MX.sym("p", 3 * n_u + 4)
-    # Expanded to scalar operations, shared subexpressions merged: as an MX graph the code
-    # spends most of its time on sparse bookkeeping (3 to 5 times the arithmetic here).
-    residual = merged(graph.expand())
-    rows_of = ca.Function("alpha_chunk_rows", [y, p], [residual(y, p)[0]])
-    shift_of = (ca.Function("alpha_chunk_shift", [y, p], [residual(y, p)[1]])
-                if st.variant == "stabilized" and n_c else None)
-    # The Jacobian from the graph (the wires' stiffness kernels): expanded it is some 30 times
-    # the residual's code, compiles for minutes and saves little (a factorization is rare).
+    # The wires' and the rest's functions expanded to scalar operations, shared subexpressions
+    # merged: as MX graphs their code spends most of its time on sparse bookkeeping.
+    residual = ChunkResidual(st, expand=True)
+    rows, shift = residual.rows_and_shift(y, p)
+    rows_of = ca.Function("alpha_chunk_rows", [y, p], [rows])
+    shift_of = ca.Function("alpha_chunk_shift", [y, p], [shift]) if st.variant == "stabilized" and n_c else None
     layout = _layout(st)
-    jac = ca.project(_jacobian(st, residual)(y, p), layout.pattern)
+    y_b, y_r = ca.MX.sym("y_b", st.bulk.n_b), ca.MX.sym("y_r", n_y - st.bulk.n_b)
+    jacobian = ca.Function("alpha_chunk_jacobian", [y_b, y_r, p], [residual.jacobian(y_b, y_r, p)])
+    jacobian_border = ca.Function("alpha_chunk_jacobian_border", [y_b, y_r, p],
+                                  [residual.jacobian(y_b, y_r, p, wires=False)])
+    jac = ca.project(jacobian(y[: st.bulk.n_b], y[st.bulk.n_b :], p), layout.pattern)
     factor = ca.MX.sym("factor", layout.size)
     factorize = ca.Function("alpha_chunk_factorize", [y, p, factor], [layout.factorize(_nonzeros(jac))])
     keep_factor = ca.Function("alpha_chunk_keep_factor", [y, p, factor], [factor])
     refresh = ca.Function.if_else("alpha_chunk_refresh", factorize, keep_factor)
+    # the border alone (bodies, joints, contacts: what moves with a point), the band's LU kept
+    border = layout.n_r > 0
+    if border:
+        jac_border = ca.project(jacobian_border(y[: st.bulk.n_b], y[st.bulk.n_b :], p), layout.pattern)
+        refactorize_border = ca.Function("alpha_chunk_border", [y, p, factor],
+                                         [layout.refactorize_border(factor, _nonzeros(jac_border))])
+        refresh_border = ca.Function.if_else("alpha_chunk_refresh_border", refactorize_border, keep_factor)
     rhs = ca.MX.sym("rhs", n_y)
     solve = ca.Function("alpha_chunk_solve", [factor, rhs], [layout.solve(factor, rhs)])
 
@@ -274,10 +277,15 @@ def _chunk_function(st: StepEquations, coef, per: int, graph: ca.Function) -> ca
         for _ in range(MAX_ITERATIONS // ROUNDS):
             y_k, e, stat, cnt = newton(stat != 0, y_k, e, stat, cnt, fr, p_k, scale, f_k)
         wanted = stat == 3
-        if round_ < ROUNDS - 1:  # slow: a fresh matrix at the current iterate, and on
+        if round_ == ROUNDS - 1:
+            continue
+        # slow: the border afresh at the current iterate first, then the whole matrix
+        if border and round_ == 0:
+            f_k = refresh_border(wanted, y_k, p_k, f_k)
+        else:
             f_k = refresh(wanted, y_k, p_k, f_k)
             fr, factorizations = ca.logic_or(fr, wanted), factorizations + wanted
-            stat, e = ca.if_else(wanted, 0, stat), ca.if_else(wanted, 0, e)
+        stat, e = ca.if_else(wanted, 0, stat), ca.if_else(wanted, 0, e)
     ok = ca.logic_and(active, stat == 1)
     u_pred, v_pred, b, _, _, gh, cm = step_data(p_k, n_u)
     a_new = (y_k[:n_u] - u_pred - (shift_of(y_k, p_k) if shift_of is not None else 0)) / bh2
@@ -299,38 +307,6 @@ def _chunk_function(st: StepEquations, coef, per: int, graph: ca.Function) -> ca
         total += fk
     return ca.Function("alpha_chunk", [x0, times, h, n, factor, renew, scale],
                        [x, f_out, ca.vertcat(*counts), total])
-
-
-def _jacobian(st: StepEquations, residual: ca.Function) -> ca.Function:
-    """``(y, p) -> J``: the iteration matrix, the step's Jacobian but for the wires' own block,
-    which is the bulk's (:func:`.alpha_bulk.bulk_rows`: elements, Rayleigh damping, force
-    elements between nodes), without what bodies, joints and contacts add there.
-
-    With a point's kernels over a whole wire (:func:`_residual`) those additions (a joint's
-    multiplier times its curvature, a contact's stiffness) couple every element's coordinates
-    with every other's in structure, through the point's element selection, although in value
-    only the element holding the point has them: differentiated as they stand they made a
-    dense block as large as the wire. Left out, the matrix is that of the modified Newton
-    iteration it already is (a joint's term is a fraction of a per cent of the wires'
-    stiffness; a stiff penalty contact slows the iteration, which then falls back to Python
-    steps)."""
-    n_b, n_y, n_u = st.bulk.n_b, st.n_y, st.n_u
-    # the border in scalar operations, differentiated where its entries depend on the unknowns
-    # (a derivative of the residual's call in all directions would be the whole residual's
-    # code ten times over)
-    y_s, p_s = residual.sx_in()
-    rows_s = residual(y_s, p_s)[0]
-    border = merged(ca.Function("alpha_chunk_border", [y_s, p_s], [ca.jacobian(rows_s, y_s[n_b:]),
-                                                                     ca.jacobian(rows_s[n_b:], y_s[:n_b])]))
-    y, p = ca.MX.sym("y", n_y), ca.MX.sym("p", 3 * n_u + 4)
-    j_cols, j_rows = border(y, p)
-    shift_b = ca.MX.sym("shift_b", n_b)
-    y_b = ca.MX.sym("y_b", n_b)
-    bulk = ca.Function("alpha_chunk_bulk_jacobian", [y_b, p, shift_b],
-                       [ca.jacobian(bulk_rows(st.form, n_b, n_u, y_b, p, shift_b), y_b)])
-    j_bb = bulk(y[:n_b], p, residual(y, p)[1][:n_b]) if n_b else ca.MX(0, 0)
-    jac = ca.blockcat([[j_bb, j_cols[:n_b, :]], [j_rows, j_cols[n_b:, :]]])
-    return ca.Function("alpha_chunk_jacobian", [y, p], [jac])
 
 
 def _layout(st: StepEquations) -> BorderedBand:

@@ -179,25 +179,8 @@ class Proxies:
         cache = self._elements.setdefault(i, {})
         found = cache.get(k)
         if found is None:
-            from ..assembly.windows import extension_length, extension_rows
-
             sl, j, index, _, _ = self.items[i]
-            n_el, n_loc = len(sl.element_start) - 1, sl.element_indices.shape[1]
-            starts = sl.element_start
-            if 0 <= k < n_el:
-                rows, cols, weights = np.arange(n_loc), sl.element_indices[k], np.ones(n_loc)
-                start, length = starts[k], starts[k + 1] - starts[k]
-            else:
-                end = k == n_el
-                edge = n_el - 1 if end else 0
-                length = extension_length(starts)
-                rows, cols, weights = extension_rows(sl.element_indices[edge], sl.wire.element.dim, end, length)
-                start = starts[n_el] if end else starts[0] - length
-            sources = self._y_of_q[cols]
-            free = sources >= 0
-            constant = np.zeros(n_loc)
-            np.add.at(constant, rows[~free], weights[~free] * self._q_fixed[cols[~free]])
-            rows, sources, weights = rows[free], sources[free], weights[free]
+            rows, sources, weights, constant, start, length = element_terms(sl, k, self._y_of_q, self._q_fixed)
             # (to set, their values, to add to, sources, weights) for y and the three blocks of p
             fills = []
             y_at, p_at = self._places[i]
@@ -208,6 +191,31 @@ class Proxies:
                               sources[add] + offset, weights[add]))
             found = cache[k] = ElementMap(index[j], rows, sources, weights, fills, float(start), float(length))
         return found
+
+
+def element_terms(sl, k: int, y_of_q: np.ndarray, q_fixed: np.ndarray):
+    """Element ``k`` of the wire of the sliding joint or contact ``sl`` (-1 and ``n_el``: its
+    straight continuations past its start and end) as terms on the free coordinates: local
+    coordinate ``rows[t]`` gets ``weights[t] * y[sources[t]]``, plus ``constant`` (the fixed
+    coordinates' share); with the element's ``start`` and ``length`` (m)."""
+    from ..assembly.windows import extension_length, extension_rows
+
+    n_el, n_loc = len(sl.element_start) - 1, sl.element_indices.shape[1]
+    starts = sl.element_start
+    if 0 <= k < n_el:
+        rows, cols, weights = np.arange(n_loc), sl.element_indices[k], np.ones(n_loc)
+        start, length = starts[k], starts[k + 1] - starts[k]
+    else:
+        end = k == n_el
+        edge = n_el - 1 if end else 0
+        length = extension_length(starts)
+        rows, cols, weights = extension_rows(sl.element_indices[edge], sl.wire.element.dim, end, length)
+        start = starts[n_el] if end else starts[0] - length
+    sources = y_of_q[cols]
+    free = sources >= 0
+    constant = np.zeros(n_loc)
+    np.add.at(constant, rows[~free], weights[~free] * q_fixed[cols[~free]])
+    return rows[free], sources[free], weights[free], constant, float(start), float(length)
 
 
 class ElementMap:

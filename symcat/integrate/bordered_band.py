@@ -17,6 +17,8 @@ non-finite solution, which the caller treats as a failed step.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import casadi as ca
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -82,9 +84,20 @@ class BorderedBand:
             return values[index.ravel(order="F").tolist()]
 
         present = self.band_from != self.nnz
-        lu = _band_lu(n_b, self.bw, present)(gather(self.band_from)) if n_b else ca.MX(0, 1)
-        if not n_r:
-            return lu
+        lu = _band_lu(n_b, self.bw, present.tobytes())(gather(self.band_from)) if n_b else ca.MX(0, 1)
+        return self._with_border(lu, gather) if n_r else lu
+
+    def refactorize_border(self, factor: ca.MX, nonzeros: ca.MX) -> ca.MX:
+        """``factor`` with its border (``E``, ``F``, ``D`` and the Schur complement) from the
+        matrix with the given nonzeros, its band's LU kept (the band's entries are not read)."""
+        if not self.n_r:
+            return factor
+        values = ca.vertcat(nonzeros, 0)
+        return self._with_border(factor[: self.n_b * (2 * self.bw + 1)],
+                                 lambda index: values[index.ravel(order="F").tolist()])
+
+    def _with_border(self, lu: ca.MX, gather) -> ca.MX:
+        n_b, n_r = self.n_b, self.n_r
         e = ca.reshape(gather(self.e_from), n_b, n_r)
         f = ca.reshape(gather(self.f_from), n_r, n_b)
         d = ca.reshape(gather(self.d_from), n_r, n_r)
@@ -113,12 +126,15 @@ class BorderedBand:
         return ca.vertcat(z[back.tolist()] if n_b else ca.MX(0, 1), y_r)
 
 
-def _band_lu(n: int, bw: int, present: np.ndarray) -> ca.Function:
+@lru_cache(maxsize=8)
+def _band_lu(n: int, bw: int, present: bytes) -> ca.Function:
     """``band -> lu``: the LU factors without pivoting of a band matrix (row-major band storage,
-    ``a[i, j]`` at ``i (2 bw + 1) + j - i + bw``; ``present`` marks the entries that can be
-    nonzero), ``L`` unit lower below the diagonal and ``U`` on and above it, in the same
+    ``a[i, j]`` at ``i (2 bw + 1) + j - i + bw``; ``present``, the bytes of a boolean array,
+    marks the entries that can be nonzero; one function per layout, so that code made of it
+    holds it once), ``L`` unit lower below the diagonal and ``U`` on and above it, in the same
     storage; straight-line scalar code (structural zeros and their fill-in followed)."""
     w = 2 * bw + 1
+    present = np.frombuffer(present, dtype=bool)
     band = ca.SX.sym("band", n * w)
     a = {}
     for i in range(n):
@@ -142,8 +158,10 @@ def _band_lu(n: int, bw: int, present: np.ndarray) -> ca.Function:
     return ca.Function("band_lu", [band], [ca.vertcat(*out)])
 
 
+@lru_cache(maxsize=8)
 def _band_solve(n: int, bw: int) -> ca.Function:
-    """``(lu, b) -> x`` with the factors of :func:`_band_lu`; straight-line scalar code."""
+    """``(lu, b) -> x`` with the factors of :func:`_band_lu`; straight-line scalar code (one
+    function per size)."""
     w = 2 * bw + 1
     lu = ca.SX.sym("lu", n * w)
     b = ca.SX.sym("b", n)

@@ -288,9 +288,8 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
         calls (:mod:`.alpha_events`), with outputs every ``t_end / n_out``.
     compiled : bool, optional
         Without ``monitor`` and ``handlers``, run the steps as compiled C, many per call
-        (:mod:`.alpha_chunk`: the same steps to the Newton tolerance; models of wires, bodies
-        and joints whose element windows do not move); with ``handlers``, compile the rest of
-        each step. The code is compiled once per model and cached. None (default): compiled
+        (:mod:`.alpha_chunk`: the same steps to the Newton tolerance; models of a few wires,
+        bodies, joints and contacts); with ``handlers``, compile the rest of each step. The code is compiled once per model and cached. None (default): compiled
         if cached or if the run has at least :data:`COMPILE_STEPS` steps; True: compiled now if
         not cached; False: every step evaluated from Python.
 

@@ -95,7 +95,8 @@ def test_a_bead_crossing_element_ends_in_the_compiled_steps(record_property):
     python, compiled = _both(lambda: ring(8, window=8), 0.4, 1e-3, rho_inf=0.9, tol=1e-10)
     assert compiled.s_m[-1, 0] - compiled.s_m[0, 0] > 2.0 * np.radians(350.0) / 8  # two element ends
     assert compiled.stats["compiled_steps"] == 400
-    assert np.abs(compiled.s_m - python.s_m).max() < 1e-8
+    # both stop Newton within 1e-10 m of the step's solution; over 400 steps that adds up
+    assert np.abs(compiled.s_m - python.s_m).max() < 1e-6
 
 
 def test_steps_the_compiled_code_cannot_take_are_taken_in_python():
@@ -107,9 +108,69 @@ def test_steps_the_compiled_code_cannot_take_are_taken_in_python():
     assert np.isfinite(compiled.q).all()
 
 
+def moving_load(n_elements=12, window=3, speed=40.0):
+    """A 1 g body driven along a taut 12 m wire on a sliding joint, carrying 100 N down (the
+    peer bench's problem 2, shorter): it crosses an element every 25 ms."""
+    from symcat.scene import Driving, PointLoad, RigidBody, SlidingJoint
+
+    section = Section.from_stiffness(1.8e7, 195.0, 1e11)
+    wire = AncfBody.straight("wire", "cable3d", [0, 0, 0], [12.0, 0, 0], n_elements,
+                             Material(E=1e11, rho=1.35 * (1 + 2e4 / 1.8e7) / section.A), section, prestrain=2e4 / 1.8e7)
+    wire.pin(0).pin(-1)
+    scene = Scene(gravity=(0.0, 0.0, 0.0))
+    scene.add(wire)
+    scene.add(RigidBody("load", 1e-3, (1e-6,) * 3, (0.5, 0.0, 0.0), held=("rotation",)))
+    scene.add(SlidingJoint("slider", "wire", "load", s0=0.5, at=(0.5, 0.0, 0.0), reference_direction=(0, 0, 1)))
+    scene.add(Driving("drive", "load", direction=(1.0, 0.0, 0.0), velocity=speed))
+    scene.add(PointLoad("force", "load", force=(0.0, -100.0, 0.0)))
+    return MultibodyModel(scene, window=window)
+
+
+def test_a_load_crossing_elements_whose_window_moves(record_property):
+    """A window of 3 of 12 elements that moves with the load: the compiled code holds one proxy
+    element, into whose places it writes the element holding the load, and a matrix border
+    whose wire rows and columns follow it; the load crosses eight element ends."""
+    python, compiled = _both(moving_load, 0.2, 1e-3, rho_inf=1.0, tol=1e-10)
+    crossed = compiled.s_m[-1, 0] - compiled.s_m[0, 0]
+    apart = np.abs(compiled.q - python.q).max()
+    record_property("apart_m", apart)
+    assert crossed > 7.5  # metres: elements of 1 m
+    assert compiled.stats["compiled_steps"] == 200
+    assert apart < 1e-7 and np.abs(compiled.s_m - python.s_m).max() < 1e-7
+
+
+def test_a_body_on_a_sliding_joint_whose_window_moves():
+    """The slider on its 8-element wire with a 2-element window (proxy elements in the code)."""
+    python, compiled = _both(lambda: slider(window=2), 0.2, 1e-3, rho_inf=0.9, tol=1e-10)
+    assert compiled.stats["compiled_steps"] == 200
+    assert np.abs(compiled.q - python.q).max() < 1e-7 and np.abs(compiled.s_m - python.s_m).max() < 1e-7
+
+
 def test_what_stays_in_python_says_why():
-    assert "windows that move" in unsupported(slider(window=2))
-    assert unsupported(slider()) is None
-    model = cable_pendulum()
-    run = generalized_alpha(model, 0.01, 1e-3, n_out=2, progress=False, compiled=False)
+    """Wheel/rail contacts, or windows that move without proxy elements; and compiled=False."""
+    from types import SimpleNamespace
+
+    wheels = SimpleNamespace(model=SimpleNamespace(wheelrail=[object()]))
+    assert "wheel/rail" in unsupported(wheels)
+    no_proxy = SimpleNamespace(model=slider(window=2), stepper=SimpleNamespace(proxies=None))
+    assert "without proxy elements" in unsupported(no_proxy)
+    run = generalized_alpha(cable_pendulum(), 0.01, 1e-3, n_out=2, progress=False, compiled=False)
     assert "compiled_steps" not in run.stats
+
+
+def test_compiled_steps_of_a_penalty_contact_that_opens_and_closes(record_property):
+    """A head launched down from a wire (penalty contact, damped wire): the contact's arc length
+    is an unknown of the step and its tangency a row; the contact opens and closes inside the
+    compiled calls; index-3 variant."""
+    from tests.dynamics.test_contact import head_under_wire
+
+    def make():
+        return head_under_wire(v0=-2.0)[0]
+
+    python, compiled = _both(make, 0.15, 5e-4, rho_inf=0.9, tol=1e-10, variant="index3")
+    apart = np.abs(compiled.q - python.q).max()
+    record_property("apart_m", apart)
+    assert compiled.stats["compiled_steps"] > 0.9 * compiled.stats["steps"]
+    assert apart < 1e-6
+    gap = compiled.contacts["contact"]["gap_m"]
+    assert (gap > 0).any() and (gap <= 0).any()  # it opened and closed
