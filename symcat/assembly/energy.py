@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import casadi as ca
 import numpy as np
+import scipy.sparse as sps
 
 from ..codegen.library import BufferedFunction, kernel_library, library_interface
 from .multibody import _gather
@@ -192,7 +193,12 @@ class EnergyTerms:
         self._energy = BufferedFunction(ca.Function("energy", [q, v], [model.kinetic_energy(q, v), potential]))
         self._power = BufferedFunction(ca.Function("power_nonconservative", [q, v, t], [power]))
         c = model.ancf.rayleigh_matrix
-        self._rayleigh = None if c is None else to_scipy(model._rayleigh_dm()).tocsr()
+        self._rayleigh = None
+        if c is not None:
+            # v^T C v of the symmetric C from its strict upper triangle and diagonal: half the
+            # sparse product of a line's length at every step
+            full = to_scipy(model._rayleigh_dm()).tocsr()
+            self._rayleigh = (sps.triu(full, k=1, format="csr"), full.diagonal())
         # the rheonomic constraints' rows (prescribed motions): lambda . C_t
         self._ct = self._constraint_rates(model, q, t)
 
@@ -229,7 +235,8 @@ class EnergyTerms:
         if self._contacts is not None:
             other += self._contacts(q, v, sc)[1]
         if self._rayleigh is not None:
-            other -= float(v @ (self._rayleigh @ v))
+            upper, diagonal = self._rayleigh
+            other -= float(2.0 * (v @ (upper @ v)) + v @ (diagonal * v))
         driving = 0.0
         if self._ct is not None:
             c_t = self._ct.nonzeros(q, t)[0]

@@ -69,6 +69,8 @@ class Bulk:
                                                   form.P))
         self._mass_rest = ca.Function("alpha_mass_rest", [q_f], [mass_rest])
         self._forces = self.jacobian = None
+        self._matrices = {}  # (beta h^2 or 0, gamma h, c_m) -> B of residual()
+        self._step = None  # (p, (B, c)) of the last step data, see residual()
         if not n_b:
             return
         y_b, shift_b = ca.MX.sym("y_b", n_b), ca.MX.sym("shift_b", n_b)
@@ -93,13 +95,55 @@ class Bulk:
 
     def residual(self, y_b, p, shift_b) -> np.ndarray:
         """The bulk's rows of the scaled step residual at the bulk unknowns ``y_b``, step data
-        ``p`` and stabilization shift ``shift_b``."""
+        ``p`` and stabilization shift ``shift_b``.
+
+        With ``a = (y_b - u_pred - shift_b) / (beta h^2)`` and ``v = v_pred + gamma h a``, the
+        residual ``beta h^2 (M (c_m a + b) + D v - f)`` is ``B (y_b - shift_b) + c - beta h^2
+        f_n``: ``B = c_m M + gamma h D`` (plus ``beta h^2 K`` of linearized wires), ``c`` the
+        rest of the affine part, both fixed over a step, and ``f_n`` the forces that are not
+        affine. One sparse product per Newton iteration instead of three."""
         n_b, n_u = self.n_b, self.n_u
         u_pred, v_pred, b, t, bh2, gh, cm = step_data(p, n_u)
+        matrix, c = self._affine(p)
         a = (y_b - u_pred[:n_b] - shift_b) / bh2
-        v = v_pred[:n_b] + gh * a
-        f = self._forces(y_b, v, t)
-        return bh2 * (self._mass_csr @ (cm * a + b[:n_b]) + self._rayleigh_csr @ v - f)
+        r = matrix @ y_b + c
+        if shift_b is not None and np.any(shift_b):
+            r -= self._matrix(p, linear=False) @ shift_b
+        f = self._forces(y_b, v_pred[:n_b] + gh * a, t)
+        if f is not None:
+            r -= bh2 * f
+        return r
+
+    def _matrix(self, p, linear: bool = True):
+        """``c_m M + gamma h D`` (with ``linear``: plus ``beta h^2 K`` of linearized wires) of
+        the step data ``p``, cached for its coefficients."""
+        bh2, gh, cm = (float(x) for x in p[3 * self.n_u + 1 : 3 * self.n_u + 4])
+        key = (bh2 if linear and self._forces.stiffness is not None else 0.0, gh, cm)
+        cache = self._matrices
+        found = cache.get(key)
+        if found is None:
+            if len(cache) > 8:  # step sizes of halvings and restarts: keep a few
+                cache.clear()
+            found = cm * self.mass_matrix + gh * self.rayleigh
+            if key[0]:
+                found = found + bh2 * self._forces.stiffness
+            found = cache[key] = found.tocsr()
+        return found
+
+    def _affine(self, p):
+        """``B`` and ``c`` of :meth:`residual` for the step data ``p`` (cached for the last
+        ``p``: the Newton iterations of a step share it)."""
+        if self._step is not None and np.array_equal(self._step[0], p):
+            return self._step[1]
+        n_b = self.n_b
+        u_pred, v_pred, b, t, bh2, gh, cm = step_data(p, self.n_u)
+        matrix = self._matrix(p)
+        c = self._mass_csr @ (bh2 * b[:n_b] - cm * u_pred[:n_b]) + self._rayleigh_csr @ (bh2 * v_pred[:n_b]
+                                                                                      - gh * u_pred[:n_b])
+        if self._forces.stiffness is not None:
+            c -= bh2 * self._forces.constant
+        self._step = (p.copy(), (matrix, c))
+        return matrix, c
 
     def mass(self, q_f: np.ndarray) -> sps.csc_matrix:
         """The mass matrix on the free coordinates at ``q_f``."""
@@ -150,9 +194,13 @@ class Bulk:
             if len(self._columns) + len(missing) > MAX_COLUMNS:
                 self._columns.clear()
                 missing = index.tolist()
-            e = np.zeros((self.n_b, len(missing)))
-            e[missing, np.arange(len(missing))] = 1.0
-            for i, col in zip(missing, self.lu.solve(e).T):
+            if isinstance(self.lu, BandedCholesky):
+                solved = self.lu.columns(np.array(missing))
+            else:
+                e = np.zeros((self.n_b, len(missing)))
+                e[missing, np.arange(len(missing))] = 1.0
+                solved = self.lu.solve(e)
+            for i, col in zip(missing, solved.T):
                 self._columns[i] = col
         for k, i in enumerate(index.tolist()):
             out[:, k] = self._columns[i]
@@ -161,11 +209,14 @@ class Bulk:
 
 
 class _BulkForces:
-    """The bulk's nonlinear forces ``f(y_b, v_b, t)`` (no Rayleigh term, free coordinates): the
-    ANCF element forces as one function of the wire coordinates and each group of bulk force
+    """The bulk's forces ``f(y_b, v_b, t)`` (no Rayleigh term, free coordinates): the ANCF
+    element forces as one function of the wire coordinates and each group of bulk force
     elements (droppers, supports) as one of the coordinates it acts on, gathered, scattered
     and mapped to the free coordinates in NumPy. One CasADi graph of it all held a work vector
-    of every coordinate per operation, and on a line evaluated some 40 % slower in the step."""
+    of every coordinate per operation, and on a line evaluated some 40 % slower in the step.
+
+    Linearized wires' forces are affine, ``constant - stiffness y_b`` (free coordinates):
+    :class:`Bulk` folds them into its step matrix, and a call leaves them out."""
 
     def __init__(self, form: Formulation, n_b: int, expand: bool):
         model = form.model
@@ -180,11 +231,17 @@ class _BulkForces:
         q, v = ca.MX.sym("q", self._n_a), ca.MX.sym("v", self._n_a)
         system = model.ancf
         # Linearized wires: one SciPy product (CasADi's sparse product in its virtual machine
-        # took five times as long).
-        self._linear = system.affine_forces()
-        if self._linear is None:
+        # took five times as long), folded into the step matrix.
+        linear = system.affine_forces()
+        self.stiffness = self.constant = None
+        if linear is None:
             self._ancf = BufferedFunction(_expanded(ca.Function("alpha_bulk_ancf", [q, v], [ca.densify(
                 system.force_function()(q, v))]), expand))
+        else:
+            f_ref, k_ref, q_ref = linear
+            to_q = self._to_q[: self._n_a]
+            self.stiffness = (self._to_free[:, : self._n_a] @ k_ref @ to_q).tocsr()
+            self.constant = self._to_free[:, : self._n_a] @ (f_ref - k_ref @ (self._q_fixed[: self._n_a] - q_ref))
         self._groups = []
         for lib, group in model.force_groups.items():
             rows, params = np.array(group.rows), np.array(group.params)
@@ -199,9 +256,30 @@ class _BulkForces:
             fn = ca.Function(f"alpha_bulk_{lib}", [q_g, v_g, t], [ca.densify(ca.vec(out))])
             flat = rows.ravel()
             self._groups.append((BufferedFunction(_expanded(fn, expand)), flat))
+        if self._picked is not None and self._groups:
+            # a group's coordinates straight from y_b (free ones) and q_fixed: no vector of all
+            y_of_q = np.full(self._n_q, -1)
+            y_of_q[self._picked] = np.arange(n_b)
+            self._gathers = []
+            for fn, flat in self._groups:
+                at = y_of_q[flat]
+                free = at >= 0
+                fixed = self._q_fixed[flat] * ~free
+                self._gathers.append((fn, np.where(free, at, 0), free, fixed, at[free]))
 
-    def __call__(self, y_b: np.ndarray, v_b: np.ndarray, t: float) -> np.ndarray:
+    def __call__(self, y_b: np.ndarray, v_b: np.ndarray, t: float) -> np.ndarray | None:
+        """The forces at ``(y_b, v_b, t)`` but the linearized wires' affine ones (None: no
+        others)."""
         picked = self._picked
+        if self.stiffness is not None:
+            if not self._groups:
+                return None
+            if picked is not None:
+                f = np.zeros(y_b.size)
+                for fn, at, free, fixed, to in self._gathers:
+                    values = fn(fixed + np.where(free, y_b[at], 0.0), np.where(free, v_b[at], 0.0), t)[0].ravel()
+                    f += np.bincount(to, values[free], minlength=y_b.size)
+                return f
         if picked is None:
             q, v = self._q_fixed + self._to_q @ y_b, self._to_q @ v_b
         else:
@@ -209,10 +287,7 @@ class _BulkForces:
             q[picked] += y_b
             v[picked] = v_b
         f = np.zeros(self._n_q)
-        if self._linear is not None:
-            f_ref, k_ref, q_ref = self._linear
-            f[: self._n_a] = f_ref - k_ref @ (q[: self._n_a] - q_ref)
-        else:
+        if self.stiffness is None:
             f[: self._n_a] = self._ancf(q[: self._n_a], v[: self._n_a])[0].ravel()
         for fn, flat in self._groups:
             f += np.bincount(flat, fn(q[flat], v[flat], t)[0].ravel(), minlength=self._n_q)

@@ -115,7 +115,7 @@ class ChunkResidual:
 
     def _substituted(self, y, p):
         """``(y, p, w, terms)``: the rest's inputs with each proxy's places holding its actual
-        element's values (as :meth:`.alpha_proxies.Proxies.substitute` writes them), the
+        element's values (as :meth:`.alpha_proxies.Proxies.placement` maps them), the
         elements' start and length ``w``, and per proxy ``(places, sources, weights)``."""
         n_y, n_u = self.n_y, self.n_u
         y_sub, p_sub, w, terms = y, p, [], []

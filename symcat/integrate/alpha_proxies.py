@@ -18,7 +18,8 @@ class Proxies:
     (interior, all coordinates free, touched by nothing else of the rest, proxies two elements
     apart) whose start and length are inputs; each evaluation writes the actual element's
     coordinates and step data into the proxy's places, and the results at the proxy's rows and
-    columns are moved back to the actual element's (dropping fixed coordinates).
+    columns are moved back to the actual element's (dropping fixed coordinates): index maps
+    built once per placement (:meth:`placement`, :mod:`.alpha_placement`).
 
     The actual element may also be a wire's straight continuation past one of its ends
     (:func:`~symcat.assembly.windows.extension_rows`), whose coordinates are linear
@@ -120,7 +121,7 @@ class Proxies:
 
     def expand(self, maps, index: np.ndarray):
         """Entries at y indices ``index`` re-expressed on the actual elements of ``maps`` (one
-        :class:`ElementMap` per item, as :meth:`substitute` returns them): ``(position in
+        :class:`ElementMap` per item): ``(position in
         index, y index, weight)`` per term; an index of no proxy stays (weight 1). All maps at
         once: an actual element may be another item's proxy element."""
         inside = index < self._owner.size
@@ -137,26 +138,39 @@ class Proxies:
                 positions.append(mine[at_term]), actuals.append(actual), weights.append(weight)
         return np.concatenate(positions), np.concatenate(actuals), np.concatenate(weights)
 
-    def substitute(self, y, p):
-        """The rest's inputs ``y[y_columns]`` and ``p[p_columns]`` (:meth:`restrict`) with each
-        proxy's places holding its actual element's values, the elements' start and length
-        ``w``, and the :class:`ElementMap` of each proxy."""
-        y_columns, p_columns = self._columns
-        y_rest, p_rest = y[y_columns], p[p_columns]
-        w = np.empty(2 * len(self.items))
-        maps = []
+    def key(self, y) -> tuple:
+        """The element of each item's wire that holds its point in ``y`` (-1 and ``n_el``: the
+        straight continuations past the wire's start and end)."""
+        key = []
         for i, (*_, where) in enumerate(self.items):
             starts = self._starts[i]
-            k = bisect.bisect_right(starts, float(y[where])) - 1  # -1 and n_el: past the wire's ends
-            k = min(max(k, -1), len(starts) - 1)
-            m = self._element(i, k)
-            for target, source, (to_set, values, to_add, sources, weights) in zip(
-                    (y_rest, p_rest, p_rest, p_rest), (y, p, p, p), m.fills):
-                target[to_set] = values
-                np.add.at(target, to_add, weights * source[sources])
-            w[2 * i], w[2 * i + 1] = m.start, m.length
-            maps.append(m)
-        return y_rest, p_rest, w, maps
+            k = bisect.bisect_right(starts, float(y[where])) - 1
+            key.append(min(max(k, -1), len(starts) - 1))
+        return tuple(key)
+
+    def placement(self, key: tuple) -> tuple:
+        """The rest's inputs with each proxy's places holding the actual elements' of ``key``
+        (:meth:`key`): ``(y terms, p terms, w, expand)`` for :class:`~.alpha_placement.Placement`,
+        ``w`` the elements' starts and lengths and ``expand`` the output map (:meth:`expand`
+        on these elements)."""
+        from .alpha_placement import Terms
+
+        y_columns, p_columns = self._columns
+        maps = [self._element(i, k) for i, k in enumerate(key)]
+        terms = []
+        for block, columns in enumerate((y_columns, p_columns)):
+            replaced = np.zeros(columns.size, bool)
+            constant = np.zeros(columns.size)
+            place, source, weight = [np.arange(columns.size)], [columns], [np.ones(columns.size)]
+            for m in maps:
+                for to_set, values, to_add, sources, weights in (m.fills[:1] if block == 0 else m.fills[1:]):
+                    replaced[to_set] = True
+                    constant[to_set] = values
+                    place.append(to_add), source.append(sources), weight.append(weights)
+            place[0], source[0], weight[0] = place[0][~replaced], source[0][~replaced], weight[0][~replaced]
+            terms.append(Terms(np.concatenate(place), np.concatenate(source), np.concatenate(weight), constant))
+        w = np.array([[m.start, m.length] for m in maps]).ravel()
+        return terms[0], terms[1], w, lambda index: self.expand(maps, index)
 
     def _element(self, i: int, k: int) -> "ElementMap":
         """The :class:`ElementMap` of element ``k`` of item ``i``'s wire (-1 and ``n_el``: the
@@ -228,13 +242,3 @@ class ElementMap:
         within = np.arange(position.size) - np.repeat(np.cumsum(counts) - counts, counts)
         term = self._first[local[position]] + within
         return position, self.sources[term], self.weights[term]
-
-
-def move_back(vector: np.ndarray, maps) -> None:
-    """Add the proxies' entries of ``vector`` to their actual elements' (in place): the
-    transpose of each :class:`ElementMap`."""
-    values = [vector[m.proxy].copy() for m in maps]
-    for m in maps:
-        vector[m.proxy] = 0.0
-    for m, v in zip(maps, values):
-        np.add.at(vector, m.sources, m.weights * v[m.rows])

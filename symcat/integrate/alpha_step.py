@@ -40,7 +40,8 @@ from ..codegen.library import BufferedFunction, symbolic_kernels
 from ..dae.formulation import Formulation
 from ..errors import SolverError
 from .alpha_bulk import Bulk, step_data
-from .alpha_proxies import Proxies, move_back
+from .alpha_placement import Placement, Terms, csc_pattern, identity, output_maps, weighted_sum
+from .alpha_proxies import Proxies
 from .alpha_rest import compiled_rest, expanded_rest
 
 #: Unknowns of the rest above which its capacitance is factorized sparse (a vehicle's bodies,
@@ -52,6 +53,7 @@ KEPT_ITERATIONS = 4
 #: A Newton iteration that contracts by less than this per iteration updates its matrix.
 SLOW_CONTRACTION = 0.3
 
+_GETRS = sla.get_lapack_funcs("getrs", dtype=np.float64)
 _SINGULAR = ("generalized-alpha: singular iteration matrix (redundant constraints, or a sliding joint at a point "
              "where its wire has no tangent?)")
 
@@ -79,10 +81,18 @@ class StepEquations:
         n_u = self.n_u
         self.n_y = n_y = n_u + n_c * (2 if variant == "stabilized" else 1) + n_sc
         self.variant, self.form = variant, form
-        self.bulk = bulk if bulk is not None else Bulk(form, n_u, expand)
+        model = form.model
+        # Few wire unknowns against the rest (the seed's 8-element wire under a vehicle, or no
+        # wire): the whole step matrix is factorized (sparse LU) instead of corrected by a
+        # Woodbury update, whose capacitance is then as large as the system and, with the
+        # stiff cross-section gradients of beam3d wires, too ill-conditioned to solve accurately.
+        n_b = int(np.count_nonzero(model.free < model.ancf.n))
+        self.direct = n_b <= n_y - n_b
+        # The bulk's Jacobian is then evaluated at every factorization: expanded to scalar
+        # operations (small here), three times faster than its graph.
+        self.bulk = bulk if bulk is not None else Bulk(form, n_u, expand or self.direct)
         y = ca.MX.sym("y", n_y)
         p = ca.MX.sym("p", 3 * n_u + 4)
-        model = form.model
         # The open flags of the wheel/rail contacts (1: lifted off), set by an event handler.
         self.mode = np.zeros(len(model.wheelrail))
         self.mode_symbol = mode = ca.MX.sym("mode", self.mode.size)
@@ -129,12 +139,14 @@ class StepEquations:
         colind, row = jac.sparsity_out(0).get_ccs()
         self._jac_rows = np.array(row, int)
         self._jac_cols = self.rest_columns[np.repeat(np.arange(k), np.diff(colind))]
+        self._placements: dict[tuple, Placement] = {}
+        if self.proxies is None:
+            n_p = self.p_columns.size
+            self._placements[()] = Placement(
+                Terms(np.arange(k), self.rest_columns, np.ones(k), np.zeros(k)),
+                Terms(np.arange(n_p), self.p_columns, np.ones(n_p), np.zeros(n_p)), np.zeros(0),
+                *output_maps(identity, self._r_rows, self._shift_rows, self._jac_rows, self._jac_cols), n_y, n_u)
         self.mass_scale = mass_scale  # kg: mean diagonal of M, converts multiplier updates to positions
-        # Few wire unknowns against the rest (the seed's 8-element wire under a vehicle, or no
-        # wire): the whole step matrix is factorized (sparse LU) instead of corrected by a
-        # Woodbury update, whose capacitance is then as large as the system and, with the
-        # stiff cross-section gradients of beam3d wires, too ill-conditioned to solve accurately.
-        self.direct = self.bulk.n_b <= self.n_y - self.bulk.n_b
         self._coupling = None
         # (beta h^2, open flags) of a sparse capacitance that later steps may keep (see
         # :meth:`keeps_coupling`), else None.
@@ -194,24 +206,26 @@ class StepEquations:
         return k
 
     # --- evaluation ---------------------------------------------------------------------------
-    def _inputs(self, y, p):
-        """The rest's inputs at ``(y, p)`` and the proxies' maps (None without proxies)."""
+    def _placement(self, y) -> Placement:
+        """The rest's index maps for the elements that hold the contact points in ``y``."""
         if self.proxies is None:
-            return y[self.rest_columns], p[self.p_columns], np.zeros(0), self.mode, None
-        y_rest, p_rest, w, maps = self.proxies.substitute(y, p)
-        return y_rest, p_rest, w, self.mode, maps
+            return self._placements[()]
+        key = self.proxies.key(y)
+        found = self._placements.get(key)
+        if found is None:
+            if len(self._placements) > 64:
+                self._placements.clear()
+            y_terms, p_terms, w, expand = self.proxies.placement(key)
+            found = self._placements[key] = Placement(
+                y_terms, p_terms, w, *output_maps(expand, self._r_rows, self._shift_rows, self._jac_rows, self._jac_cols),
+                self.n_y, self.n_u)
+        return found
 
     def _rest_values(self, y, p):
         """The rest's residual (n_y) and shift (n_u) at ``(y, p)``, dense."""
-        y_rest, p_in, w, mode, maps = self._inputs(y, p)
-        r_nz, shift_nz, *_ = self._rest.nonzeros(y_rest, p_in, w, mode)
-        r, shift = np.zeros(self.n_y), np.zeros(self.n_u)
-        r[self._r_rows] = r_nz
-        shift[self._shift_rows] = shift_nz
-        if maps is not None:
-            move_back(r, maps)
-            move_back(shift, maps)
-        return r, shift
+        placement = self._placement(y)
+        r_nz, shift_nz, *_ = self._rest.nonzeros(*placement.inputs(y, p), self.mode)
+        return placement.residual(r_nz, shift_nz)
 
     def residual(self, y, p) -> np.ndarray:
         r, shift = self._rest_values(y, p)
@@ -230,8 +244,7 @@ class StepEquations:
         if self.n_sc:
             y[self.n_y - self.n_sc :] = sc
         p = np.r_[u, v, np.zeros(n_u), t, 1.0, 1.0, 1.0]
-        y_rest, p_in, w, mode, _ = self._inputs(y, p)
-        _, _, gap, force = self._rest.nonzeros(y_rest, p_in, w, mode)
+        _, _, gap, force = self._rest.nonzeros(*self._placement(y).inputs(y, p), self.mode)
         return gap, force
 
     def update(self, y, p) -> tuple:
@@ -246,46 +259,67 @@ class StepEquations:
         """The mass matrix (free coordinates, scipy sparse) at the positions of ``y``."""
         return self.bulk.mass(y[: self.form.n_f])
 
-    def _rest_triplets(self, y, p):
-        """The rest's exact Jacobian as (rows, columns, values), nonzero values only, with the
-        bulk rows' dependence on ``nu`` through the shift of ``a`` under the stabilized form:
-        ``-(c_m M + gamma h C) G^T`` with the constant bulk mass and Rayleigh matrices."""
-        y_rest, p_in, w, mode, maps = self._inputs(y, p)
-        values = self._rest_jacobian.nonzeros(y_rest, p_in, w, mode)[0]
-        keep = values != 0
-        rows, cols, data = self._jac_rows[keep], self._jac_cols[keep], values[keep]
-        if maps is not None:  # the proxies' rows and columns are made of the actual elements'
-            # J_actual = T^T J_proxy T, T the maps of the proxy coordinates
-            at, rows, weight = self.proxies.expand(maps, rows)
-            cols, data = cols[at], data[at] * weight
-            at, cols, weight = self.proxies.expand(maps, cols)
-            rows, data = rows[at], data[at] * weight
+    def _rest_triplets(self, y, p) -> tuple[Placement, np.ndarray]:
+        """The rest's exact Jacobian at ``(y, p)``: its placement, whose ``jac_rows`` and
+        ``jac_cols`` are the terms' rows and columns (duplicates add), and their values."""
+        placement = self._placement(y)
+        values = self._rest_jacobian.nonzeros(*placement.inputs(y, p), self.mode)[0]
+        data = placement.jacobian(values)
+        extra = self._shift_coupling(placement, data, p)
+        return placement, data if extra is None else np.concatenate([data, extra])
+
+    def _shift_coupling(self, placement: Placement, data, p) -> np.ndarray | None:
+        """The bulk rows' dependence on ``nu`` through the shift of ``a`` under the stabilized
+        form, ``-(c_m M + gamma h C) G^T`` with the constant bulk mass and Rayleigh matrices:
+        the values of terms (dense on the rows it reaches, appended to the placement's pattern
+        at the first call) given the rest's Jacobian values ``data``; None if there are none."""
         n_b, n_u, n_c = self.bulk.n_b, self.n_u, self.n_c
-        if self.variant == "stabilized" and n_b:
-            g = (rows >= n_u) & (rows < n_u + n_c) & (cols < n_b)  # G on the bulk coordinates
-            if np.any(g):
-                _, _, _, _, _, gh, cm = step_data(p, n_u)
+        if self.variant != "stabilized" or not n_b:
+            return None
+        found = placement.cache.get("shift")
+        if found is None:
+            rows, cols = placement.jac_rows, placement.jac_cols
+            g = np.flatnonzero((rows >= n_u) & (rows < n_u + n_c) & (cols < n_b))  # G on the bulk coordinates
+            found = None
+            if g.size:
                 g_cols, at = np.unique(cols[g], return_inverse=True)
-                g_b = np.zeros((g_cols.size, n_c))  # G^T on the bulk columns it touches
-                np.add.at(g_b, (at, rows[g] - n_u), data[g])
-                block = cm * self.bulk.mass_matrix[:, g_cols] + gh * self.bulk.rayleigh[:, g_cols]
-                extra = (-(block @ sps.csr_matrix(g_b))).tocoo()
-                rows = np.r_[rows, extra.row]
-                cols = np.r_[cols, n_u + n_c + extra.col]
-                data = np.r_[data, extra.data]
-        return rows, cols, data
+                g_rows, row_at = np.unique(rows[g] - n_u, return_inverse=True)  # the constraints on the bulk
+                reach = abs(self.bulk.mass_matrix[:, g_cols]) + abs(self.bulk.rayleigh[:, g_cols])
+                reached = np.unique(reach.nonzero()[0])
+                found = (g, g_cols, at, row_at, g_rows.size, reached)
+                placement.add_terms(np.repeat(reached, g_rows.size), np.tile(n_u + n_c + g_rows, reached.size))
+            placement.cache["shift"] = found
+        if found is None:
+            return None
+        g, g_cols, at, row_at, n_g, reached = found
+        _, _, _, _, _, gh, cm = step_data(p, n_u)
+        block = placement.cache.get("block")
+        if block is None or block[0] != (gh, cm):
+            dense = (cm * self.bulk.mass_matrix[reached][:, g_cols] + gh * self.bulk.rayleigh[reached][:, g_cols])
+            block = placement.cache["block"] = ((gh, cm), dense.toarray())
+        g_b = np.zeros((g_cols.size, n_g))  # G^T on the bulk columns it touches
+        np.add.at(g_b, (at, row_at), data[g])
+        return -(block[1] @ g_b).ravel()
 
     def jacobian(self, y, p) -> sps.csc_matrix:
-        """The whole step Jacobian at ``(y, p)`` (bulk and rest; the starting acceleration's
-        filter needs it once)."""
-        rows, cols, data = self._rest_triplets(y, p)
-        jac = sps.csc_matrix((data, (rows, cols)), shape=(self.n_y, self.n_y))
-        n_b = self.bulk.n_b
+        """The whole step Jacobian at ``(y, p)`` (bulk and rest), assembled on a pattern kept
+        per placement."""
+        placement, data = self._rest_triplets(y, p)
+        n_b, n_y = self.bulk.n_b, self.n_y
         if n_b:
             shift = self._rest_values(y, p)[1]
-            a = self.bulk.jacobian.sparse(y[:n_b], p, shift[:n_b])[0]
-            jac = jac + sps.block_diag([a, sps.csc_matrix((self.n_y - n_b,) * 2)], format="csc")
-        return jac.tocsc()
+            data = np.concatenate([data, self.bulk.jacobian.nonzeros(y[:n_b], p, shift[:n_b])[0]])
+        pattern = placement.cache.get("csc")
+        if pattern is None:
+            rows, cols = placement.jac_rows, placement.jac_cols
+            if n_b:
+                bulk_rows, bulk_cols = self.bulk.jacobian.function.sparsity_out(0).get_triplet()
+                rows, cols = np.r_[rows, bulk_rows], np.r_[cols, bulk_cols]
+            pattern = placement.cache["csc"] = csc_pattern(rows, cols, n_y)
+        place, indices, indptr = pattern
+        jac = sps.csc_matrix((weighted_sum(place, data, indices.size), indices, indptr), shape=(n_y, n_y))
+        jac.eliminate_zeros()  # the pattern's structural zeros (open contacts...) would cost the sparse LU
+        return jac
 
     # --- the linear solve ---------------------------------------------------------------------
     def factorize(self, y, p) -> None:
@@ -315,18 +349,15 @@ class StepEquations:
             self._prepared = (float(p[3 * self.n_u + 1]), self.mode.copy())
             return
         n_b, n_y = self.bulk.n_b, self.n_y
-        r_i, c_i, data = self._rest_triplets(y, p)
-        touched = np.unique(np.concatenate([r_i[r_i < n_b], c_i[c_i < n_b]]))
-        keys = np.concatenate([touched, np.arange(n_b, n_y)])
-        pos = np.full(n_y, -1)
-        pos[keys] = np.arange(keys.size)
-        k = keys.size
-        n_t = touched.size
+        placement, data = self._rest_triplets(y, p)
+        keys, flat, k = placement.touched(n_b)
+        n_t = k - (n_y - n_b)
+        touched = keys[:n_t]
         z_bulk = self.bulk.columns(touched) if n_t else np.zeros((n_b, 0))
         if k > DENSE_CAPACITANCE:
             # Bodies with many coordinates (a vehicle on a line): the capacitance is the rest's
             # sparse Jacobian but for the block of the touched wire unknowns.
-            delta = sps.csr_matrix((data, (pos[r_i], pos[c_i])), shape=(k, k))
+            delta = sps.csr_matrix((data, (flat // k, flat % k)), shape=(k, k))
             delta = (delta - sps.diags(np.r_[np.zeros(n_t), np.ones(k - n_t)])).tocsr()
             z_k = sps.block_diag([sps.csr_matrix(z_bulk[touched]), sps.identity(k - n_t)], format="csr")
             try:
@@ -336,8 +367,7 @@ class StepEquations:
             self._coupling = (keys, n_t, delta, z_bulk, cap)
             self._prepared = (float(p[3 * self.n_u + 1]), self.mode.copy())
             return
-        delta = np.zeros((k, k))
-        np.add.at(delta, (pos[r_i], pos[c_i]), data)
+        delta = weighted_sum(flat, data, k * k).reshape(k, k)
         delta[n_t:, n_t:] -= np.eye(k - n_t)
         z_k = np.eye(k)
         if n_t:
@@ -372,7 +402,12 @@ class StepEquations:
         n_b = self.bulk.n_b
         x = rhs.copy()
         x[:n_b] = self.bulk.solve(rhs[:n_b])
-        w = cap.solve(delta @ x[keys]) if isinstance(cap, spla.SuperLU) else sla.lu_solve(cap, delta @ x[keys], check_finite=False)
+        if not keys.size:  # wires only
+            return x
+        if isinstance(cap, spla.SuperLU):
+            w = cap.solve(delta @ x[keys])
+        else:  # LAPACK directly: lu_solve's checks cost as much as this small solve
+            w = _GETRS(*cap, delta @ x[keys])[0]
         x[:n_b] -= z_bulk @ w[:n_t]
         x[n_b:] -= w[n_t:]
         return x

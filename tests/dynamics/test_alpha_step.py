@@ -87,3 +87,80 @@ def test_proxy_element_equals_the_window(line):
         np.testing.assert_allclose(a, b, atol=1e-12 * max(1.0, np.abs(b).max()))
     ja, jb = proxied.jacobian(y, p), windowed.jacobian(y, p)
     assert abs(ja - jb).max() < 1e-10 * abs(jb).max()
+
+
+@pytest.mark.parametrize("wires", ["nonlinear", "linear"])
+def test_bulk_residual_is_the_step_formula(wires):
+    """The bulk's residual, evaluated as one step matrix times the unknowns plus the forces that
+    are not affine, equals ``beta h^2 (M (c_m a + b) - f(q, v, t))`` evaluated whole in CasADi
+    (``f`` with Rayleigh damping; linearized wires: their affine forces folded into the matrix)."""
+    import casadi as ca
+
+    form_found = find_form(benchmark2015(2), 6, progress=False)
+    model = MultibodyModel(catenary_scene(form_found, wires=wires))
+    form = Formulation(model, "augmented", "1")
+    st = StepEquations(form, "index3")
+    bulk, n_b, n_u = st.bulk, st.bulk.n_b, st.n_u
+    rng = np.random.default_rng(11)
+    c, h = AlphaCoefficients(0.8), 1e-3
+    u0 = model.q0[model.free]
+    p = np.r_[u0, rng.normal(0, 1e-2, n_u), rng.normal(0, 1.0, n_u), 0.3, c.beta * h * h, c.gamma * h,
+              (1 - c.alpha_m) / (1 - c.alpha_f)]
+    y_b = u0[:n_b] + rng.normal(0, 1e-4, n_b)
+    shift = np.zeros(n_b)
+    bh2, gh, cm = p[3 * n_u + 1 :]
+    a = (y_b - p[:n_b]) / bh2
+    v = p[n_u : n_u + n_b] + gh * a
+    q_sym, v_sym = ca.MX.sym("q", model.n_q), ca.MX.sym("v", model.n_q)
+    f = ca.Function("f", [q_sym, v_sym], [model.forces(q_sym, v_sym, 0.3, "bulk")])
+    q_full, v_full = model.q0.copy(), np.zeros(model.n_q)
+    q_full[model.free[:n_b]], v_full[model.free[:n_b]] = y_b, v
+    forces = np.array(f(q_full, v_full)).ravel()[model.free[:n_b]]
+    expected = bh2 * (bulk.mass_matrix @ (cm * a + p[2 * n_u : 2 * n_u + n_b]) - forces)
+    got = bulk.residual(y_b, p, shift)
+    assert np.abs(got - expected).max() < 1e-9 * np.abs(expected).max()
+    # the next step's data (the affine part is cached per step data) and a shift
+    p2 = p.copy()
+    p2[:n_u] += 1e-6
+    shift[:5] = 1e-7
+    a2 = (y_b - p2[:n_b] - shift) / bh2
+    v_full[model.free[:n_b]] = p2[n_u : n_u + n_b] + gh * a2
+    forces = np.array(f(q_full, v_full)).ravel()[model.free[:n_b]]
+    expected = bh2 * (bulk.mass_matrix @ (cm * a2 + p2[2 * n_u : 2 * n_u + n_b]) - forces)
+    assert np.abs(bulk.residual(y_b, p2, shift) - expected).max() < 1e-9 * np.abs(expected).max()
+
+
+def test_banded_columns_are_the_solves():
+    """Columns of the inverse solved on a window of the band equal whole solves (a line-like
+    matrix: a chain whose columns decay away from their index), also past the window's first
+    width and at the matrix's ends."""
+    import scipy.sparse as sps
+
+    from symcat.assembly.banded import BandedCholesky
+
+    n = 3000
+    rng = np.random.default_rng(2)
+    chain = sps.diags([np.full(n - 1, -1.0), np.full(n, 2.05), np.full(n - 1, -1.0)], [-1, 0, 1])
+    shuffle = rng.permutation(n)
+    matrix = chain.tocsr()[shuffle][:, shuffle]
+    lu = BandedCholesky(matrix)
+    for index in ([0, 1, 2], shuffle[[1500, 1501]], shuffle[[n - 1]], shuffle[[10, 2990]]):
+        index = np.asarray(index)
+        e = np.zeros((n, index.size))
+        e[index, np.arange(index.size)] = 1.0
+        exact = lu.solve(e)
+        np.testing.assert_allclose(lu.columns(index), exact, rtol=0, atol=1e-14 * np.abs(exact).max())
+
+
+def test_kept_patterns_give_a_fresh_builds_jacobian(line):
+    """The Jacobian assembled on the pattern kept from an earlier evaluation (and the shift
+    coupling's dense block kept for the step coefficients) equals that of equations built afresh,
+    at another point and another step size."""
+    form = Formulation(line, "augmented", "1")
+    used, fresh = StepEquations(form, "stabilized"), StepEquations(form, "stabilized")
+    rng = np.random.default_rng(8)
+    used.jacobian(*_point(used, line, rng))
+    y, p = _point(used, line, rng)
+    p[3 * used.n_u + 1 :] *= [0.25, 0.5, 1.0]  # half the step
+    ja, jb = used.jacobian(y, p), fresh.jacobian(y, p)
+    assert abs(ja - jb).max() <= 1e-12 * abs(jb).max()
