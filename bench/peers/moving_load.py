@@ -111,7 +111,7 @@ def _steps(k):
 
 
 SYMCAT_IDAS = [{"rtol": r} for r in (1e-4, 1e-5, 1e-6)]
-SYMCAT_ALPHA = [{"dt": _steps(k), "tol": 1e-8} for k in (1, 2, 4, 8)]
+SYMCAT_ALPHA = [{"dt": _steps(k), "tol": 1e-8} for k in (1, 2, 4, 8, 16, 32)]
 EXUDYN = [{"dt": _steps(k)} for k in (1, 2, 4, 8, 16, 32)]
 SYMCAT_REFERENCE = {"dt": _steps(64), "tol": 1e-12}
 EXUDYN_REFERENCE = {"dt": _steps(64), "newton_rtol": 1e-10}
