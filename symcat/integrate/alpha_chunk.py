@@ -63,7 +63,8 @@ MAX_BORDER = 60
 #: against their arithmetic).
 MAX_BAND_WORK = 60_000
 
-#: This module's and the factorization's code, part of the compiled library's key.
+#: The code the compiled library follows from (this module, the residual, the factorization and
+#: the proxies), part of its cache key.
 _SOURCE = b"".join((Path(__file__).parent / name).read_bytes()
                    for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "bordered_band.py", "alpha_proxies.py"))
 

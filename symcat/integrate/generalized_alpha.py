@@ -95,12 +95,14 @@ from .results import SimulationResult
 from .simulate import one_handler
 
 VARIANTS = ("index3", "stabilized")
-#: Steps from which a run compiles its steps to C when no compiled ones are cached (the steps
-#: of :mod:`.alpha_chunk`; with wheel/rail contacts the rest of each step,
-#: :class:`~.alpha_step.StepEquations`); a shorter run uses cached ones or Python. Compiling
-#: takes seconds for a small wire, about 30 s for the seed scene's rest (once per machine and
-#: model), which a short run would not repay.
+#: Steps from which a run with wheel/rail contacts compiles the rest of its steps to C when no
+#: compiled one is cached (:class:`~.alpha_step.StepEquations`); a shorter run uses a cached one
+#: or the expanded functions. Compiling the seed scene's takes about 30 s (once per machine and
+#: model); its compiled step then runs the scene about 1.5 times faster.
 COMPILE_STEPS = 2000
+#: Steps from which a run compiles its steps (:mod:`.alpha_chunk`) when they are not cached: the
+#: compiler's 5 to 50 s (once per model) against the Python steps' extra 0.5 to 2 ms each.
+CHUNK_COMPILE_STEPS = 20_000
 
 
 
@@ -166,7 +168,7 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
     state = integ.start(x, z, h)
     # Without a per-step monitor the steps run compiled, many per call; a short run compiles
     # them only if asked (``compiled=True``), else uses them if cached.
-    chunks = (CompiledSteps(integ, h, per, build=bool(compiled) or n_steps >= COMPILE_STEPS)
+    chunks = (CompiledSteps(integ, h, per, build=bool(compiled) or n_steps >= CHUNK_COMPILE_STEPS)
               if compiled is not False and monitor is None else None)
     run.multipliers[0] = state.lam
 
@@ -289,9 +291,11 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
     compiled : bool, optional
         Without ``monitor`` and ``handlers``, run the steps as compiled C, many per call
         (:mod:`.alpha_chunk`: the same steps to the Newton tolerance; models of a few wires,
-        bodies, joints and contacts); with ``handlers``, compile the rest of each step. The code is compiled once per model and cached. None (default): compiled
-        if cached or if the run has at least :data:`COMPILE_STEPS` steps; True: compiled now if
-        not cached; False: every step evaluated from Python.
+        bodies, joints and contacts); with ``handlers``, compile the rest of each step. The
+        code is compiled once per model and cached. None (default): compiled if cached or if
+        the run has at least :data:`CHUNK_COMPILE_STEPS` steps (the rest of wheel/rail steps:
+        :data:`COMPILE_STEPS`); True: compiled now if not cached; False: every step evaluated
+        from Python.
 
     Returns
     -------

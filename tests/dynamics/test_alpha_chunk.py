@@ -139,13 +139,6 @@ def test_a_load_crossing_elements_whose_window_moves(record_property):
     assert apart < 1e-7 and np.abs(compiled.s_m - python.s_m).max() < 1e-7
 
 
-def test_a_body_on_a_sliding_joint_whose_window_moves():
-    """The slider on its 8-element wire with a 2-element window (proxy elements in the code)."""
-    python, compiled = _both(lambda: slider(window=2), 0.2, 1e-3, rho_inf=0.9, tol=1e-10)
-    assert compiled.stats["compiled_steps"] == 200
-    assert np.abs(compiled.q - python.q).max() < 1e-7 and np.abs(compiled.s_m - python.s_m).max() < 1e-7
-
-
 def test_what_stays_in_python_says_why():
     """Wheel/rail contacts, or windows that move without proxy elements; and compiled=False."""
     from types import SimpleNamespace
