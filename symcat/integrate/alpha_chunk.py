@@ -94,7 +94,7 @@ class CompiledSteps:
                 integ.stats["compiled_steps"] = integ.stats.get("compiled_steps", 0) + done
                 integ.stats["newton_iterations"] += iterations
                 k += done
-                self._windows(s)
+                integ.move_windows(s)  # the Python steps' equations follow the points
                 if k == n or done or not renew:
                     continue  # all done, or a failure that a call with a fresh matrix may pass
             if k < n:  # no compiled steps here, or failed on a fresh matrix: one Python step
@@ -147,10 +147,6 @@ class CompiledSteps:
         if done:
             s = self._unpack(x)
         return done, s, int(its[:done].sum())
-
-    def _windows(self, s: State) -> None:
-        """Move the element windows with their points (for the Python steps' equations)."""
-        self.integ.move_windows(s)
 
     # --- the packed state: u v v_dot a lam sc a_prev lam_prev sc_prev h failed --------------
     def _pack(self, s: State) -> np.ndarray:

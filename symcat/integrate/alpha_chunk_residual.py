@@ -22,6 +22,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+from ..assembly.sparse import to_casadi_sparse
 from ..codegen.library import merged
 from .alpha_bulk import bulk_rows, step_data
 from .alpha_proxies import element_terms
@@ -83,7 +84,7 @@ class ChunkResidual:
             y_r = y_s[n_b:]
             self._rest_jacobian = merged(ca.Function("alpha_chunk_rest_jacobian", [y_s, p_s, w_s], [
                 ca.jacobian(rows_s, y_r), ca.jacobian(rows_s[n_b:], y_s[:n_b]),
-                ca.jacobian(shift_s[:n_b], y_s[self._nu])]))
+                ca.jacobian(shift_s[:n_b], y_s[self._nu]), shift_s]))
         self._tables = self._element_tables() if self.proxies is not None else []
 
     # --- the proxies' substitution ----------------------------------------------------------
@@ -180,25 +181,22 @@ class ChunkResidual:
     def jacobian(self, y_b, y_r, p, wires: bool = True):
         """The iteration matrix at ``y = [y_b, y_r]`` (symbols: wires' coordinates and the
         rest's unknowns), see the module's notes; ``wires=False``: its wires' block zero (for
-        a refactorization of the border only)."""
+        a refactorization of the border only). Built with ``expand`` (the rest's border is
+        differentiated in scalar operations)."""
         n_b, n_u = self.n_b, self.n_u
         y = ca.vertcat(y_b, y_r)
-        if self._rest_jacobian is not None and self.proxies is not None:
+        if self.proxies is not None:
             y_sub, p_sub, w, terms = self._substituted(y, p)
-            j_cols, j_rows, d_shift = self._rest_jacobian(y_sub, p_sub, w)
+            j_cols, j_rows, d_shift, shift = self._rest_jacobian(y_sub, p_sub, w)
             # chain rule through the substitution: rows and columns at the proxies' places are
             # the actual element's
-            j_cols, d_shift = self._moved_back(j_cols, terms), self._moved_back(d_shift, terms)
+            j_cols, d_shift, shift = (self._moved_back(j_cols, terms), self._moved_back(d_shift, terms),
+                                      self._moved_back(shift, terms))
             j_rows = self._moved_back(j_rows.T, terms).T
-        elif self._rest_jacobian is not None:
-            j_cols, j_rows, d_shift = self._rest_jacobian(y, p, ca.MX(0, 1))
         else:
-            rows, shift = self.parts(y, p)
-            j_cols, j_rows, d_shift = (ca.jacobian(rows, y_r), ca.jacobian(rows[n_b:], y_b),
-                                       ca.jacobian(shift[:n_b], y_r)[:, [i - n_b for i in self._nu]])
+            j_cols, j_rows, d_shift, shift = self._rest_jacobian(y, p, ca.MX(0, 1))
         if not n_b:
             return j_cols
-        shift = self.parts(y, p)[1]
         j_bb = self._bulk_jacobian(y_b, p, shift[:n_b]) if wires else ca.MX(n_b, n_b)
         # the wires' rows through the stabilization's shift of their accelerations (the
         # velocity multipliers' columns): -(c_m M + gamma h C) G^T, with the constant mass and
@@ -208,7 +206,8 @@ class ChunkResidual:
             bulk = self.st.bulk
             nu = [i - n_b for i in self._nu]
             g_t = d_shift
-            through_shift = -(cm * ca.mtimes(_dm(bulk.mass_matrix), g_t) + gh * ca.mtimes(_dm(bulk.rayleigh), g_t))
+            through_shift = -(cm * ca.mtimes(to_casadi_sparse(bulk.mass_matrix), g_t)
+                              + gh * ca.mtimes(to_casadi_sparse(bulk.rayleigh), g_t))
             upper = ca.MX(j_cols[:n_b, :])
             upper[:, nu] = upper[:, nu] + through_shift
         else:
@@ -230,9 +229,3 @@ def _set(matrix, places: np.ndarray, values):
     out = ca.MX(matrix)
     out[places.tolist(), :] = values
     return out
-
-
-def _dm(matrix) -> ca.DM:
-    """A SciPy sparse matrix as a CasADi DM (same pattern)."""
-    m = matrix.tocsc()
-    return ca.DM(ca.Sparsity(m.shape[0], m.shape[1], m.indptr.tolist(), m.indices.tolist()), m.data.tolist())

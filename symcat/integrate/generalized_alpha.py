@@ -196,10 +196,11 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
                     if chunks is not None:
                         state = chunks.advance(state, step * h, per)
                         step += per
-                    for _ in range(per if chunks is None else 0):
-                        state = integ.advance(state, step * h, h)
-                        step += 1
-                        record(step * h)
+                    else:
+                        for _ in range(per):
+                            state = integ.advance(state, step * h, h)
+                            step += 1
+                            record(step * h)
                 except StepFailure as fail:
                     t1 = (math.floor(fail.t0 / h + 1e-9) + 1) * h
                     tried = (f"nor with the step halved {max_halvings} times (the last try, {fail.h:.3g} s "
