@@ -8,13 +8,22 @@ analysis's dense eigensolver, large, keeps them).
 """
 from __future__ import annotations
 
+import sys
 from contextlib import contextmanager
+
+#: The thread-pool controller and the number of imported modules it was made with: finding
+#: the loaded BLAS libraries scans every shared library of the process (milliseconds, as much
+#: as a short run's integration), so it is done again only after new imports (which may load
+#: another BLAS).
+_CONTROLLER: list = [None, -1]
 
 
 @contextmanager
 def serial_blas():
     """Run the body with one BLAS thread (restored on exit)."""
-    from threadpoolctl import threadpool_limits
+    from threadpoolctl import ThreadpoolController
 
-    with threadpool_limits(limits=1, user_api="blas"):
+    if _CONTROLLER[1] != len(sys.modules):
+        _CONTROLLER[:] = [ThreadpoolController(), len(sys.modules)]
+    with _CONTROLLER[0].limit(limits=1, user_api="blas"):
         yield

@@ -69,18 +69,18 @@ def model_library(build: Callable[[], ca.Function], fn: ca.Function, mode: str |
 
 
 def compiled_library(name: str, key: bytes, write_c: Callable[[Path], Path], mode: str | None = None,
-                     build: bool = True) -> Path | None:
+                     build: bool = True, optimized_flags: tuple = OPTIMIZED_FLAGS) -> Path | None:
     """Path of the cached library ``name`` identified by ``key``, compiled from the C that
     ``write_c(folder)`` writes (returning its path) when the library is not cached yet: -O0
-    first and optimized in the background, or optimized now, or -O0 only (``mode``, default
-    ``$SYMCAT_OPTIMIZE``, :mod:`.optimized`). ``build=False``: only a library already cached
-    (``None`` if there is none)."""
+    first and optimized (``optimized_flags``) in the background, or optimized now, or -O0 only
+    (``mode``, default ``$SYMCAT_OPTIMIZE``, :mod:`.optimized`). ``build=False``: only a
+    library already cached (``None`` if there is none)."""
     mode = optimize_mode() if mode is None else mode
     plain = cached_library(name, key, FLAGS)
-    optimized = cached_library(name, key, OPTIMIZED_FLAGS)
+    optimized = cached_library(name, key, optimized_flags)
     if mode != "off" and optimized.exists():
         return optimized
-    target, flags = (optimized, OPTIMIZED_FLAGS) if mode == "now" else (plain, FLAGS)
+    target, flags = (optimized, optimized_flags) if mode == "now" else (plain, FLAGS)
     if not build:
         return target if target.exists() else plain if plain.exists() else None
     if not target.exists():
@@ -96,7 +96,7 @@ def compiled_library(name: str, key: bytes, write_c: Callable[[Path], Path], mod
         COMPILED["n"] += 1
         COMPILED["seconds"] += time.perf_counter() - t0
     if mode == "background" and source_path(optimized).exists():  # also a job that died
-        start_background(optimized)
+        start_background(optimized, optimized_flags)
     return target
 
 

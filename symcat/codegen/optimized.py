@@ -82,9 +82,9 @@ def _running(lock: Path) -> bool:
     return True
 
 
-def start_background(library: Path) -> bool:
-    """Start compiling :func:`source_path` of ``library`` into ``library`` in a background
-    process, unless one runs already; True if one was started."""
+def start_background(library: Path, flags: tuple = OPTIMIZED_FLAGS) -> bool:
+    """Start compiling :func:`source_path` of ``library`` into ``library`` with ``flags`` in a
+    background process, unless one runs already; True if one was started."""
     lock = _lock_path(library)
     for _ in range(2):
         try:
@@ -97,7 +97,7 @@ def start_background(library: Path) -> bool:
     else:
         return False
     try:
-        job = subprocess.Popen([sys.executable, "-m", "symcat.codegen.optimized", str(library)],
+        job = subprocess.Popen([sys.executable, "-m", "symcat.codegen.optimized", str(library), *flags],
                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                start_new_session=True)
         os.write(fd, str(job.pid).encode())
@@ -125,15 +125,16 @@ def wait_for_background(timeout_s: float = 300.0) -> bool:
     return True
 
 
-def _compile(library: Path) -> int:
-    """The background job: compile the waiting C into ``library``, then remove the C and the
-    lock (also on failure, whose message is left in ``<library>.failed``: it would fail again)."""
+def _compile(library: Path, flags: tuple = OPTIMIZED_FLAGS) -> int:
+    """The background job: compile the waiting C into ``library`` with ``flags``, then remove
+    the C and the lock (also on failure, whose message is left in ``<library>.failed``: it
+    would fail again)."""
     from .library import build_library, find_compiler
 
     source = source_path(library)
     try:
         os.nice(10)
-        build_library(find_compiler(), OPTIMIZED_FLAGS, source, library)
+        build_library(find_compiler(), flags, source, library)
         return 0
     except Exception as exc:  # noqa: BLE001 - reported in a file: nobody reads this process's stderr
         library.with_suffix(".failed").write_text(f"{type(exc).__name__}: {exc}\n")
@@ -144,4 +145,4 @@ def _compile(library: Path) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(_compile(Path(sys.argv[1])))
+    sys.exit(_compile(Path(sys.argv[1]), tuple(sys.argv[2:]) or OPTIMIZED_FLAGS))

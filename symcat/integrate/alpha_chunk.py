@@ -63,6 +63,12 @@ MAX_BORDER = 60
 #: against their arithmetic).
 MAX_BAND_WORK = 60_000
 
+#: The optimized tier's flags (:mod:`symcat.codegen.optimized`; the models' DAEs use -Og): the
+#: steps are a few thousand operations run millions of times, where -O2's scheduling takes a
+#: tenth to a seventh off the run, for a compiler time (in the background) about three times
+#: -Og's.
+OPTIMIZED_FLAGS = ("-O2", "-fPIC", "-shared")
+
 #: The code the compiled library follows from (this module, the residual, the factorization and
 #: the proxies), part of its cache key.
 _SOURCE = b"".join((Path(__file__).parent / name).read_bytes()
@@ -94,7 +100,8 @@ class CompiledSteps:
                 integ.stats["compiled_steps"] = integ.stats.get("compiled_steps", 0) + done
                 integ.stats["newton_iterations"] += iterations
                 k += done
-                integ.move_windows(s)  # the Python steps' equations follow the points
+                # (no window to move: the compiled steps run on proxy elements or on windows
+                # that never move, see unsupported)
                 if k == n or done or not renew:
                     continue  # all done, or a failure that a call with a fresh matrix may pass
             if k < n:  # no compiled steps here, or failed on a fresh matrix: one Python step
@@ -129,6 +136,7 @@ class CompiledSteps:
             self.disabled = str(exc)
             return False
         self._factor = np.zeros(layout.size)
+        self._cuts = np.cumsum([0, st.n_u, st.n_u, st.n_u, st.n_u, st.n_c, st.n_sc, st.n_u, st.n_c, st.n_sc]).tolist()
         self._scale = np.full(st.n_y, integ.tol)
         self._scale[st.n_u : st.n_u + st.n_c] *= st.mass_scale
         return True
@@ -141,8 +149,7 @@ class CompiledSteps:
         x, self._factor, its, factorizations = self._fns[length].nonzeros(
             self._pack(s), t + h * np.arange(length), h, min(n, per), self._factor, float(self._renew), self._scale)
         self.integ.stepper.bulk.factorizations += int(factorizations[0])
-        failed = np.flatnonzero(its <= 0)
-        done = min(int(failed[0]) if failed.size else length, n, per)
+        done = min(int(np.argmin(its > 0)) if its.min() <= 0 else length, n, per)
         self._renew = done < min(n, per)  # a failure: renew the matrix where the next call starts
         if done:
             s = self._unpack(x)
@@ -154,9 +161,7 @@ class CompiledSteps:
         return np.concatenate([s.u, s.v, s.v_dot, s.a, s.lam, s.sc, a_prev, lam_prev, sc_prev, [s.h, 0.0]])
 
     def _unpack(self, x: np.ndarray) -> State:
-        st = self.integ.stepper
-        n_u, n_c, n_sc = st.n_u, st.n_c, st.n_sc
-        cuts = np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc])
+        cuts = self._cuts
         u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev = (x[i:j] for i, j in zip(cuts[:-1], cuts[1:]))
         return State(u, v, v_dot, a, lam, sc, (a_prev, lam_prev, sc_prev), float(x[cuts[-1]]))
 
@@ -187,10 +192,24 @@ def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> dict 
             fns = _chunk_functions(st, coef)
         return write_functions_c(fns, "alpha_chunk", folder)
 
-    path = compiled_library("alpha_chunk", key, write, build=build)  # -O0 first, optimized in the background
+    path = compiled_library("alpha_chunk", key, write, build=build,  # -O0 first, optimized in the background
+                            optimized_flags=OPTIMIZED_FLAGS)
     if path is None:
         return None
-    return {length: BufferedFunction(ca.external(f"alpha_chunk_{length}", str(path))) for length in LENGTHS}
+    return _Lengths(path)
+
+
+class _Lengths(dict):
+    """The library's functions by length, loaded at first use (a run at one output interval
+    calls one or two of them)."""
+
+    def __init__(self, path: Path):
+        super().__init__()
+        self.path = path
+
+    def __missing__(self, length: int) -> BufferedFunction:
+        fn = self[length] = BufferedFunction(ca.external(f"alpha_chunk_{length}", str(self.path)))
+        return fn
 
 
 def _graph(residual: ChunkResidual) -> ca.Function:

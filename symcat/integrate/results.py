@@ -13,6 +13,7 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from ..assembly.wheelrail import GAP_ROW
+from ..codegen.library import BufferedFunction
 from ..dae.formulation import Formulation, normal_forces_numeric
 from ..dae.initial import KKTPattern, settle_creep
 
@@ -257,11 +258,10 @@ class _Mapped:
     def __call__(self, *rows) -> list[np.ndarray]:
         n = rows[0].shape[0]
         if n not in self._maps:
-            self._maps[n] = self.fn.map(n)
-        out = self._maps[n](*(np.asarray(r, float).T for r in rows))
-        out = out if isinstance(out, (list, tuple)) else [out]  # one output comes back bare
-        # reshape: an empty output may come back 0 x 0
-        return [np.asarray(o).reshape(size, n).T for o, size in zip(out, self._sizes)]
+            self._maps[n] = BufferedFunction(self.fn.map(n))
+        # The mapped inputs are (size, n), column-major: the rows' own row-major order.
+        out = self._maps[n](*(np.asarray(r, float).reshape(n, -1).ravel() for r in rows))
+        return [o.reshape(size, n).T for o, size in zip(out, self._sizes)]
 
 
 class _PostTerms:

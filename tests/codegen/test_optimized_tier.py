@@ -117,3 +117,24 @@ def test_an_unknown_mode_is_refused_with_its_name(monkeypatch):
         optimized.optimize_mode()
     monkeypatch.setenv("SYMCAT_OPTIMIZE", " Now ")
     assert optimized.optimize_mode() == "now"
+
+
+def test_a_library_with_its_own_optimized_flags_is_compiled_with_them(cache):
+    """The compiled generalized-alpha steps take -O2 where the DAEs take -Og: the background
+    job compiles with the caller's flags, into the library those flags name."""
+    from symcat.codegen.library import write_functions_c
+
+    x = ca.SX.sym("x")
+    tiny = ca.Function("tiny", [x], [x * x + 1])
+    flags = ("-O2", "-fPIC", "-shared")
+
+    def write(folder):
+        return write_functions_c([tiny], "tiny", folder)
+
+    plain = model_dae.compiled_library("tiny", b"tiny", write, "background", optimized_flags=flags)
+    assert optimized.wait_for_background(120.0)
+    expected = cache / cached_library("tiny", b"tiny", flags).name
+    assert expected.exists() and expected != plain
+    assert expected.name != cached_library("tiny", b"tiny", optimized.OPTIMIZED_FLAGS).name
+    assert model_dae.compiled_library("tiny", b"tiny", write, "background", optimized_flags=flags) == expected
+    assert float(ca.external("tiny", str(expected))(3.0)) == 10.0
