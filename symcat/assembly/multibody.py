@@ -277,14 +277,26 @@ class MultibodyModel(ElementWindows):
         if part == "rest":
             m = ca.MX(self.n_q, self.n_q)
         else:
-            m = ca.MX(to_casadi_sparse(sps.block_diag([self.ancf.mass_matrix, sps.csc_matrix((self.n_q - self.ancf.n,) * 2)], format="csc")))
+            m = ca.MX(self._structure("ancf mass", lambda: to_casadi_sparse(sps.block_diag(
+                [self.ancf.mass_matrix, sps.csc_matrix((self.n_q - self.ancf.n,) * 2)], format="csc"))))
         if self.scene.rigid_bodies and part != "bulk":
             idx = np.array([self._rigid_indices(b.name) for b in self.scene.rigid_bodies])
             p = ca.DM(np.array([b.params for b in self.scene.rigid_bodies]).T)
             lib = kernel_library("rigid")
             blocks = lib["rigid_mass"].map(len(idx))(_gather(q, idx), p)
-            m += MatrixScatter.square(idx, self.n_q, lib["rigid_mass"].sparsity_out(0))(blocks)
+            scatter = self._structure("rigid mass", lambda: MatrixScatter.square(idx, self.n_q,
+                                                                               lib["rigid_mass"].sparsity_out(0)))
+            m += scatter(blocks)
         return m
+
+    def _structure(self, key, build):
+        """``build()``, once per model: the index maps and constant matrices that the MX
+        builders assemble from the model's fixed layout (the builders run for every graph made
+        of the model, a dozen per run; rebuilding these took half their time)."""
+        cache = self.__dict__.setdefault("_structures", {})
+        if key not in cache:
+            cache[key] = build()
+        return cache[key]
 
     def _rayleigh_dm(self) -> ca.DM:
         """The scene's Rayleigh damping matrix (:attr:`System.rayleigh_matrix`) over all
@@ -317,7 +329,7 @@ class MultibodyModel(ElementWindows):
             idx = np.array([self._rigid_indices(b.name) for b in bodies])
             p = ca.DM(np.array([b.params for b in bodies]).T)
             qv = kernel_library("rigid")["rigid_qv"].map(len(bodies))(_gather(q, idx), _gather(v, idx), p)
-            f += ca.mtimes(vector_scatter(idx, self.n_q), ca.vec(qv))
+            f += ca.mtimes(self._structure("rigid forces", lambda: vector_scatter(idx, self.n_q)), ca.vec(qv))
             g = self.scene.gravity_vector()
             weight = np.zeros(self.n_q)
             for b, rows in zip(bodies, idx):
@@ -332,7 +344,7 @@ class MultibodyModel(ElementWindows):
                     continue
             fn = kernel_library(lib)[lib].map(len(rows))
             out = fn(_gather(q, rows), _gather(v, rows), t, ca.DM(params.T))
-            f += ca.mtimes(vector_scatter(rows, self.n_q), ca.vec(out))
+            f += ca.mtimes(self._structure(("forces", lib, part), lambda: vector_scatter(rows, self.n_q)), ca.vec(out))
         return f
 
     def _sliding_local(self, sl: Sliding, q: ca.MX, v: ca.MX, s: ca.MX, s_dot: ca.MX):
@@ -356,8 +368,8 @@ class MultibodyModel(ElementWindows):
             n_c = library_interface(lib)["n_c"]
             c_parts.append(ca.vec(kl[f"{lib}_c"].map(m)(y, t, p)))
             c_y, c_t = kl[f"{lib}_jac"].map(m)(y, t, p)
-            local_rows = np.arange(m * n_c).reshape(m, n_c)
-            scatter = MatrixScatter(local_rows, rows, (m * n_c, self.n_q), kl[f"{lib}_jac"].sparsity_out(0))
+            scatter = self._structure(("constraints", lib), lambda: MatrixScatter(
+                np.arange(m * n_c).reshape(m, n_c), rows, (m * n_c, self.n_q), kl[f"{lib}_jac"].sparsity_out(0)))
             cq_parts.append(scatter(c_y))
             cs_parts.append(ca.MX(m * n_c, self.n_s))
             ct_parts.append(ca.vec(c_t))
@@ -369,7 +381,8 @@ class MultibodyModel(ElementWindows):
             c_parts.append(kl[f"{sl.library}_c"](y, t, p))
             c_y, c_t = kl[f"{sl.library}_jac"](y, t, p)
             n_loc = sl.element_indices.shape[1]
-            cq = ca.mtimes(c_y[:, :n_loc], sel) + _place(c_y[:, n_loc : n_loc + 7], self._rigid_indices(sl.body.name), self.n_q)
+            body = self._structure(("sliding body", k), lambda: _placement(self._rigid_indices(sl.body.name), self.n_q))
+            cq = ca.mtimes(c_y[:, :n_loc], sel) + ca.mtimes(c_y[:, n_loc : n_loc + 7], body)
             cq_parts.append(cq)
             cs = ca.MX(3, self.n_s)
             cs[:, k] = c_y[:, n_loc + 7]
@@ -421,9 +434,14 @@ def _gather(x: ca.MX, rows: np.ndarray) -> ca.MX:
 
 def _place(block: ca.MX, cols, n: int) -> ca.MX:
     """Put the columns of ``block`` at global columns ``cols`` of an (rows x n) matrix."""
+    return ca.mtimes(block, _placement(cols, n))
+
+
+def _placement(cols, n: int) -> ca.MX:
+    """The matrix that puts a block's columns at global columns ``cols`` of ``n``."""
     cols = list(cols)
     p = sps.csc_matrix((np.ones(len(cols)), (np.arange(len(cols)), cols)), shape=(len(cols), n))
-    return ca.mtimes(block, ca.MX(to_casadi_sparse(p)))
+    return ca.MX(to_casadi_sparse(p))
 
 
 def _available() -> set[str]:

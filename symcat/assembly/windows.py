@@ -69,30 +69,53 @@ class ElementWindows:
         (the wire of the next tension section, raised towards its anchor), with the closest
         point defined everywhere, instead of a cubic extrapolated far beyond its element."""
         lo, hi = sl.window
+        lower, upper, weight_of, pattern, starts, lengths = self._structure(
+            ("selection", id(sl), lo, hi), lambda: self._selection_layout(sl))
+        masks = ca.logic_and(s >= lower, s < upper)
+        n_el = len(sl.element_start) - 1
+        if lo == 0:
+            masks = ca.vertcat(masks, s < sl.element_start[0])
+        if hi == n_el:
+            masks = ca.vertcat(masks, s >= sl.element_start[n_el])
+        values = ca.mtimes(weight_of, masks)
+        sel = ca.sparsity_cast(values, pattern)
+        start = ca.dot(masks, starts)
+        length = ca.dot(masks, lengths)
+        override = self.element_override.get(id(sl))
+        if override is not None:  # a stand-in element: the actual one's start and length given
+            start, length = override
+        return sel, start, length
+
+    def _selection_layout(self, sl):
+        """The constants of :meth:`_selection` for ``sl``'s window: the elements' bounds (one
+        comparison per bound for the whole window; its first and last elements reach to its
+        edges unless a wire end is there), the weights that turn the masks into ``Sel``'s
+        nonzeros, ``Sel``'s pattern, and the elements' starts and lengths (the wire's straight
+        continuations last)."""
+        lo, hi = sl.window
         n_el = len(sl.element_start) - 1
         n_loc = sl.element_indices.shape[1]
         before, after = lo == 0, hi == n_el
-        masks, triplets = [], []  # triplets: (local row, global column, weight) per window element
-        for k in range(lo, hi):
-            below = s >= sl.element_start[k] if k > lo or before else ca.MX(1)
-            above = s < sl.element_start[k + 1] if k < hi - 1 or after else ca.MX(1)
-            masks.append(ca.logic_and(below, above))
-            triplets.append((np.arange(n_loc), sl.element_indices[k], np.ones(n_loc)))
+        lower = np.array(sl.element_start[lo:hi], float)
+        upper = np.array(sl.element_start[lo + 1 : hi + 1], float)
+        if not before:
+            lower[0] = -np.inf
+        if not after:
+            upper[-1] = np.inf
+        # triplets: (local row, global column, weight) per window element
+        triplets = [(np.arange(n_loc), sl.element_indices[k], np.ones(n_loc)) for k in range(lo, hi)]
         starts = list(sl.element_start[lo:hi])
         lengths = list(np.diff(sl.element_start)[lo:hi])
         dim = sl.wire.element.dim
         reach = extension_length(sl.element_start)
         if before:
-            masks.append(s < sl.element_start[0])
             triplets.append(extension_rows(sl.element_indices[0], dim, at_end=False, length=reach))
             starts.append(sl.element_start[0] - reach)
             lengths.append(reach)
         if after:
-            masks.append(s >= sl.element_start[n_el])
             triplets.append(extension_rows(sl.element_indices[n_el - 1], dim, at_end=True, length=reach))
             starts.append(sl.element_start[n_el])
             lengths.append(reach)
-        masks = ca.vertcat(*masks)
         rows = np.concatenate([t[0] for t in triplets])
         cols = np.concatenate([t[1] for t in triplets])
         weights = np.concatenate([t[2] for t in triplets])
@@ -102,14 +125,7 @@ class ElementWindows:
         keys, inverse = np.unique(cols * n_loc + rows, return_inverse=True)  # CSC order: by column, then row
         weight_of = sps.csr_matrix((weights, (inverse, owner)), shape=(keys.size, len(triplets)))
         pattern = ca.Sparsity.triplet(n_loc, self.n_q, (keys % n_loc).tolist(), (keys // n_loc).tolist())
-        values = ca.mtimes(ca.DM(weight_of), masks)
-        sel = ca.sparsity_cast(values, pattern)
-        start = ca.dot(masks, ca.DM(starts))
-        length = ca.dot(masks, ca.DM(lengths))
-        override = self.element_override.get(id(sl))
-        if override is not None:  # a stand-in element: the actual one's start and length given
-            start, length = override
-        return sel, start, length
+        return ca.DM(lower), ca.DM(upper), ca.DM(weight_of), pattern, ca.DM(starts), ca.DM(lengths)
 
 
 def extension_length(element_start: np.ndarray) -> float:

@@ -165,13 +165,7 @@ class BufferedFunction:
             self._buffer.set_arg(i, memoryview(a))
         for i, a in enumerate(self._outputs):
             self._buffer.set_res(i, memoryview(a))
-        # Per output: its shape and the row-major positions of its nonzeros (CasADi's are
-        # column-major): one 1-D scatter per call.
-        self._patterns = []
-        for i in range(function.n_out()):
-            sp = function.sparsity_out(i)
-            flat = np.array(sp.row(), int) * sp.shape[1] + np.array(sp.get_col(), int)
-            self._patterns.append((sp.shape, sp.shape[0] * sp.shape[1], flat))
+        self._patterns = None  # see __call__
 
     def sparse(self, *args) -> list:
         """The outputs as SciPy CSC matrices (patterns read once), at the inputs ``args``."""
@@ -215,6 +209,15 @@ class BufferedFunction:
         RuntimeError
             If the function reports a failed evaluation (as a regular call does).
         """
+        if self._patterns is None:
+            # Per output: its shape and the row-major positions of its nonzeros (CasADi's are
+            # column-major): one 1-D scatter per call. Built at the first call: a caller of
+            # nonzeros() never needs them, and on large outputs they take milliseconds.
+            self._patterns = []
+            for i in range(self.function.n_out()):
+                sp = self.function.sparsity_out(i)
+                flat = np.array(sp.row(), int) * sp.shape[1] + np.array(sp.get_col(), int)
+                self._patterns.append((sp.shape, sp.shape[0] * sp.shape[1], flat))
         self._evaluate(args)
         out = []
         for nz, (shape, size, flat) in zip(self._outputs, self._patterns):

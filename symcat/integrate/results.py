@@ -254,14 +254,22 @@ class _Mapped:
         self._sizes = [fn.sparsity_out(i).numel() for i in range(fn.n_out())]
         if any(fn.sparsity_out(i).size2() != 1 and size for i, size in enumerate(self._sizes)):
             raise ValueError(f"{fn.name()}: the outputs must be column vectors to be mapped row-wise")
+        # The mapped outputs' nonzeros are each evaluation's in turn: per output, the rows
+        # its nonzeros fill.
+        self._rows = [np.array(fn.sparsity_out(i).row(), int) for i in range(fn.n_out())]
 
     def __call__(self, *rows) -> list[np.ndarray]:
         n = rows[0].shape[0]
         if n not in self._maps:
             self._maps[n] = BufferedFunction(self.fn.map(n))
         # The mapped inputs are (size, n), column-major: the rows' own row-major order.
-        out = self._maps[n](*(np.asarray(r, float).reshape(n, -1).ravel() for r in rows))
-        return [o.reshape(size, n).T for o, size in zip(out, self._sizes)]
+        out = self._maps[n].nonzeros(*(np.asarray(r, float).reshape(n, -1).ravel() for r in rows))
+        dense = []
+        for nz, size, where in zip(out, self._sizes, self._rows):
+            d = np.zeros((n, size))
+            d[:, where] = nz.reshape(n, where.size)
+            dense.append(d)
+        return dense
 
 
 class _PostTerms:
