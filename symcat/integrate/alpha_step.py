@@ -271,7 +271,7 @@ class StepEquations:
         self.last_iterations = 0
         self.history = StartHistory()
         self.last_shift = None  # the shift G^T nu of the last update()
-        self._secants = Secants(n_y)  # Broyden updates of a direct factorization, see secant()
+        self._secants = Secants(n_y if self.direct else 0)  # Broyden updates of a direct factorization, see secant()
 
     def reset(self) -> None:
         """Forget the factorizations, the prepared coupling and the open flags (a new run on
