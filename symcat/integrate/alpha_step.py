@@ -122,7 +122,10 @@ class StartHistory:
             self.continues = self.key == bh2 and len(self.a) == 1
             return None
         a = self.a
-        if np.abs(y0[:n_u] - p[:n_u] - bh2 * (a[-1] + (a[-1] - a[-2]))).max() > 1e-6 * tol:
+        u_pred = p[:n_u]
+        # to the rounding of u_pred (the coordinates far down a line are large)
+        off = np.abs(y0[:n_u] - u_pred - bh2 * (a[-1] + (a[-1] - a[-2]))) - 1e-14 * np.abs(u_pred)
+        if off.max() > 1e-6 * tol:
             self.clear()  # the state is not the chain's last (a restart, a redo or a halving)
             return None
         self.continues = True
