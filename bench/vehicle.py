@@ -209,6 +209,27 @@ def section(report_dir=None) -> list[str]:
     ]
 
 
+def alpha_scene_run(t_end: float = 1.0) -> dict:
+    """One run of the complete scene (``seo2005``) on generalized-alpha (the model's dt 1 ms and
+    tol 1e-8 m, ``t_end`` s): its wall time per simulated second (the result's ``wall_s``:
+    integration and post-processing, not the model's build), Newton iterations, factorizations
+    and contact-force statistics. ``python -m bench.vehicle alpha`` prints one run as JSON: run it
+    from two checkouts in turn (old, new, old, ...) and compare medians, so that both see the
+    same load of a shared machine."""
+    out = _run("seo2005", {"t_end": t_end, "integrator": "generalized_alpha"})
+    stats = out.arrays["result"].stats
+    return {"wall_per_simulated_s": out.summary["wall_s"] / t_end, "steps": stats.get("steps"),
+            "newton_iterations": stats.get("newton_iterations"), "factorizations": stats.get("factorizations"),
+            "contact_force_mean_N": out.summary["contact_force_mean_N"],
+            "contact_force_std_N": out.summary["contact_force_std_N"]}
+
+
+if __name__ == "__main__" and sys.argv[1:] == ["alpha"]:
+    import json
+
+    print(json.dumps(alpha_scene_run()))
+    sys.exit(0)
+
 if __name__ == "__main__":
     lines = section()
     (Path(__file__).resolve().parent / "report" / "vehicle.md").write_text("\n".join(lines) + "\n")

@@ -52,9 +52,14 @@ class Bulk:
         Free coordinates and sliding-joint arc lengths (the layout of ``p``).
     expand : bool
         Expand the bulk's functions to SX when the graph allows it.
+    whole : bool
+        Evaluate the residual as one expanded function of ``(y_b, p, shift_b)`` (the wires'
+        element forces called as their compiled kernels) instead of in pieces (see
+        :meth:`residual`): for a few wire elements, where the pieces' NumPy and SciPy calls
+        cost more than the evaluation (the seed's 8-element wire: 23 instead of 70 us).
     """
 
-    def __init__(self, form: Formulation, n_u: int, expand: bool = False):
+    def __init__(self, form: Formulation, n_u: int, expand: bool = False, whole: bool = False):
         model = form.model
         self.n_b = n_b = int(np.count_nonzero(model.free < model.ancf.n))
         self.n_f, self.n_u = form.n_f, n_u
@@ -71,11 +76,18 @@ class Bulk:
         self._forces = self.jacobian = None
         self._matrices = {}  # (beta h^2 or 0, gamma h, c_m) -> B of residual()
         self._step = None  # (p, (B, c)) of the last step data, see residual()
+        self._whole = None  # the residual as one function, see ``whole``
         if not n_b:
             return
         y_b, shift_b = ca.MX.sym("y_b", n_b), ca.MX.sym("shift_b", n_b)
         p = ca.MX.sym("p", 3 * n_u + 4)
         r_b = bulk_rows(form, n_b, n_u, y_b, p, shift_b)
+        if whole:
+            try:
+                self._whole = BufferedFunction(ca.Function("alpha_bulk_residual", [y_b, p, shift_b],
+                                                           [ca.densify(r_b)]).expand())
+            except RuntimeError:
+                pass
         fns = [ca.Function("alpha_bulk_jacobian", [y_b, p, shift_b], [ca.jacobian(r_b, y_b)])]
         if expand:
             try:
@@ -102,6 +114,8 @@ class Bulk:
         f_n``: ``B = c_m M + gamma h D`` (plus ``beta h^2 K`` of linearized wires), ``c`` the
         rest of the affine part, both fixed over a step, and ``f_n`` the forces that are not
         affine. One sparse product per Newton iteration instead of three."""
+        if self._whole is not None:
+            return self._whole.nonzeros(y_b, p, 0.0 if shift_b is None else shift_b)[0]
         n_b, n_u = self.n_b, self.n_u
         u_pred, v_pred, b, t, bh2, gh, cm = step_data(p, n_u)
         matrix, c = self._affine(p)

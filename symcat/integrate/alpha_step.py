@@ -21,7 +21,9 @@ ANCF coordinates of the elements a contact can currently touch (its element wind
 When the wires are not the larger part of the unknowns (the seed paper's 8-element wire under
 its vehicle, or no wire at all) the whole step matrix is factorized instead (sparse LU), and a
 rest of many unknowns keeps its factorization over the steps while Newton converges fast
-(:meth:`StepEquations.keeps_coupling`).
+(:meth:`StepEquations.keeps_coupling`), improved in between by Broyden's secant updates
+(:meth:`StepEquations.secant`). Under the stabilized form the iteration starts from the
+multipliers ``nu`` extrapolated from the last steps (:class:`StartHistory`).
 
 This is how dedicated pantograph/catenary codes keep a constant iteration matrix while the
 contact point moves; refactorizing a 7,000-unknown line whenever the contact crosses an element,
@@ -52,10 +54,126 @@ DENSE_CAPACITANCE = 200
 KEPT_ITERATIONS = 4
 #: A Newton iteration that contracts by less than this per iteration updates its matrix.
 SLOW_CONTRACTION = 0.3
+#: With the step matrix factorized whole (:attr:`StepEquations.direct`) and kept over steps,
+#: an update of the matrix (the rest's Jacobian and a sparse LU) costs as much as some ten
+#: iterations: the iteration updates its matrix when it contracts by less than
+#: ``DIRECT_SLOW_CONTRACTION`` from its third update on, or when its second update exceeds
+#: its first by ``DIRECT_FIRST_CONTRACTION``. The first ratio is no measure of the rate: an
+#: error of the kept matrix in a soft direction (the torsion of a beam3d wire's cross-sections
+#: under the contact) shows as an overshoot in the first update that the second undoes, after
+#: which the iteration converges fast. A step after one of more than
+#: ``DIRECT_KEPT_ITERATIONS`` iterations starts from an updated matrix.
+DIRECT_SLOW_CONTRACTION = 0.5
+DIRECT_FIRST_CONTRACTION = 1.0
+DIRECT_KEPT_ITERATIONS = 5
+#: SuperLU's options for the step matrix factorized whole: a symmetric ordering (the pattern is
+#: structurally symmetric but for the constraints' rows: less fill than the default column
+#: ordering, so faster solves) and threshold partial pivoting that keeps a diagonal pivot within
+#: a factor 10 of its column's largest entry.
+DIRECT_LU = {"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.1}
+#: Broyden updates of a kept step matrix at most (:meth:`StepEquations.secant`).
+MAX_SECANTS = 20
+#: A secant update that would scale the Newton update by more than this is skipped.
+SECANT_GAIN = 10.0
 
 _GETRS = sla.get_lapack_funcs("getrs", dtype=np.float64)
 _SINGULAR = ("generalized-alpha: singular iteration matrix (redundant constraints, or a sliding joint at a point "
              "where its wire has no tangent?)")
+
+
+class StartHistory:
+    """The stabilization multipliers ``nu`` and the positions' shifts ``G^T nu`` of the last
+    two converged steps of equal size (a *chain*: each step started where the one before
+    ended), from which :meth:`StepEquations.start` extrapolates them for the Newton
+    iteration's start (the shift extrapolated too: evaluating it at the start cost a rest
+    evaluation per step for a start guess).
+
+    ``nu`` corrects the positions' drift from the velocity constraints: it is not small
+    against the Newton tolerance, but it changes smoothly from step to step, whereas the
+    integrator's predictor (``nu = 0``) puts all of it, and its shift of the positions, into
+    the first update.
+
+    The chain continues into a step only when the integrator's own (linear) prediction of
+    ``a`` is the one from the chain's last two accelerations: the same step size, and not
+    after a restart, a halving or a call redone from an earlier state. (``a`` itself is left to
+    the integrator's predictor: extrapolated to higher orders it predicted the seed's complete
+    scene closer, yet cost more refactorizations, the kept matrix's error in the wire's soft
+    torsion showing more.)"""
+
+    def __init__(self):
+        self.clear()
+
+    def clear(self) -> None:
+        self.key = None  # beta h^2 of the chain's steps
+        self.a: list = []
+        self.nu: list = []
+        self.shift: list = []
+        self.mode = None  # the open flags of the chain's last step
+        self.continues = False  # the step under way continues the chain
+
+    def predict(self, y0, p, n_u: int, mode, tol: float):
+        """``(nu, shift)`` extrapolated for the step of data ``p`` whose integrator's predictor
+        is ``y0`` (None where the chain does not reach: shorter than two steps, another step
+        size or other open contacts, or not continuing into this step)."""
+        bh2 = float(p[3 * n_u + 1])
+        self.continues = False
+        if self.key != bh2 or len(self.a) < 2:
+            # a chain of one step cannot be checked: it continues unchecked (the next step checks it)
+            self.continues = self.key == bh2 and len(self.a) == 1
+            return None
+        a = self.a
+        u_pred = p[:n_u]
+        # to the rounding of u_pred (the coordinates far down a line are large)
+        off = np.abs(y0[:n_u] - u_pred - bh2 * (a[-1] + (a[-1] - a[-2]))) - 1e-14 * np.abs(u_pred)
+        if off.max() > 1e-6 * tol:
+            self.clear()  # the state is not the chain's last (a restart, a redo or a halving)
+            return None
+        self.continues = True
+        if len(self.nu) < 2 or not np.array_equal(self.mode, mode):
+            return None
+        return 2.0 * self.nu[-1] - self.nu[-2], 2.0 * self.shift[-1] - self.shift[-2]
+
+    def converged(self, a, nu, shift, p, n_u: int, mode) -> None:
+        """Add the converged step's ``a``, ``nu`` and ``shift``."""
+        if not self.continues:
+            self.clear()
+            self.key = float(p[3 * n_u + 1])
+        self.a = (self.a + [a.copy()])[-2:]
+        self.nu = (self.nu + [nu.copy()])[-2:]
+        self.shift = (self.shift + [shift])[-2:]
+        self.mode = mode.copy()
+        self.continues = False
+
+
+class Secants:
+    """Broyden's updates of an inverse matrix ``H_0`` in product form, ``H = (I + s_k c_k^T)
+    ... (I + s_1 c_1^T) H_0`` (:meth:`StepEquations.secant`), applied at once: with ``z_0 = H_0
+    v``, ``H v = z_0 + S^T alpha`` where ``alpha`` solves the unit lower triangular ``alpha_j -
+    sum_{i<j} (c_j^T s_i) alpha_i = c_j^T z_0``, whose inverse is kept (a few products with
+    small matrices instead of ``k`` pairs of vector operations)."""
+
+    def __init__(self, n: int):
+        self.s = np.zeros((MAX_SECANTS, n))
+        self.c = np.zeros((MAX_SECANTS, n))
+        self.inverse = np.zeros((MAX_SECANTS, MAX_SECANTS))  # of the triangular matrix above
+        self.k = 0
+
+    def clear(self) -> None:
+        self.k = 0
+
+    def add(self, s: np.ndarray, c: np.ndarray) -> None:
+        k = self.k
+        self.s[k], self.c[k] = s, c
+        # [[L, 0], [l^T, 1]]^-1 = [[L^-1, 0], [-l^T L^-1, 1]] with l_i = -c^T s_i
+        self.inverse[k, :k] = (self.s[:k] @ c) @ self.inverse[:k, :k]
+        self.inverse[k, k] = 1.0
+        self.k = k + 1
+
+    def apply(self, z0: np.ndarray) -> np.ndarray:
+        k = self.k
+        if not k:
+            return z0
+        return z0 + (self.inverse[:k, :k] @ (self.c[:k] @ z0)) @ self.s[:k]
 
 
 class StepEquations:
@@ -89,8 +207,9 @@ class StepEquations:
         n_b = int(np.count_nonzero(model.free < model.ancf.n))
         self.direct = n_b <= n_y - n_b
         # The bulk's Jacobian is then evaluated at every factorization: expanded to scalar
-        # operations (small here), three times faster than its graph.
-        self.bulk = bulk if bulk is not None else Bulk(form, n_u, expand or self.direct)
+        # operations (small here), three times faster than its graph; its residual likewise
+        # one expanded function.
+        self.bulk = bulk if bulk is not None else Bulk(form, n_u, expand or self.direct, whole=self.direct)
         y = ca.MX.sym("y", n_y)
         p = ca.MX.sym("p", 3 * n_u + 4)
         # The open flags of the wheel/rail contacts (1: lifted off), set by an event handler.
@@ -104,7 +223,8 @@ class StepEquations:
                 self.proxies.install(w)
             # The rest depends on few unknowns: entered as a structurally sparse y, its graph and
             # Jacobian never touch the other thousands.
-            probe = ca.Function("alpha_rest", [y, p, w, mode], [self._rows(y, p, mode)[0]])
+            rows = self._rows(y, p, mode, contacts=True)  # built once: the graph of a vehicle takes a while
+            probe = ca.Function("alpha_rest", [y, p, w, mode], [rows[0]])
             self.rest_columns = np.unique(np.array(probe.sparsity_jac(0, 0).get_col(), int))
             k = self.rest_columns.size
             y_rest = ca.MX.sym("y_rest", k)
@@ -112,7 +232,7 @@ class StepEquations:
             # Likewise the step data: the predictors of the few unknowns it touches and the
             # scalars (copying the whole p into the function at every call cost more than its
             # evaluation on a line).
-            outputs = ca.vertcat(*self._rows(y, p, mode, contacts=True))
+            outputs = ca.vertcat(*rows)
             used = ca.Function("alpha_rest", [y, p, w, mode], [outputs]).sparsity_jac(1, 0).get_col()
             self.p_columns = np.union1d(np.array(used, int), np.arange(3 * n_u, 3 * n_u + 4))
             p_rest = ca.MX.sym("p_rest", self.p_columns.size)
@@ -152,6 +272,9 @@ class StepEquations:
         # :meth:`keeps_coupling`), else None.
         self._prepared = None
         self.last_iterations = 0
+        self.history = StartHistory()
+        self.last_shift = None  # the shift G^T nu of the last update()
+        self._secants = Secants(n_y if self.direct else 0)  # Broyden updates of a direct factorization, see secant()
 
     def reset(self) -> None:
         """Forget the factorizations, the prepared coupling and the open flags (a new run on
@@ -161,6 +284,8 @@ class StepEquations:
         self.bulk._last = None
         self.mode[:] = 0.0
         self._coupling, self._prepared, self.last_iterations = None, None, 0
+        self._secants.clear()
+        self.history.clear()
 
     def _rows(self, y, p, mode, contacts: bool = False, part: str = "rest"):
         """The rest's scaled residual rows and the stabilization's shift ``G^T nu`` at ``(y,
@@ -251,6 +376,7 @@ class StepEquations:
         """``a``, ``v`` and ``v_dot`` at the end of the step whose unknowns are ``y``."""
         # the index-3 form has no shift: no evaluation of the rest
         shift = self._rest_values(y, p)[1] if self.variant == "stabilized" else 0.0
+        self.last_shift = shift
         u_pred, v_pred, b, _, bh2, gh, cm = step_data(p, self.n_u)
         a = (y[: self.n_u] - u_pred - shift) / bh2
         return a, v_pred + gh * a, cm * a + b
@@ -341,8 +467,9 @@ class StepEquations:
         columns ``Z = P^-1 E_K`` (``P`` = bulk matrix, identity elsewhere), and the factorized
         capacitance ``I + Delta Z_K`` with ``Delta = J_rest[K, K] - I`` on the non-bulk part."""
         if self.direct:
+            self._secants.clear()
             try:
-                self._coupling = spla.splu(self.jacobian(y, p))
+                self._coupling = spla.splu(self.jacobian(y, p), **DIRECT_LU)
             except RuntimeError:
                 raise SolverError(_SINGULAR) from None
             self.bulk.factorizations += 1
@@ -381,23 +508,69 @@ class StepEquations:
         self._coupling = (keys, n_t, delta, z_bulk, cap)
         self._prepared = None
 
+    def start(self, y0, p, tol: float) -> np.ndarray:
+        """The Newton iteration's start from the integrator's predictor ``y0``: under the
+        stabilized form, ``nu`` and the positions' shift ``G^T nu`` (which the converged
+        positions hold) extrapolated from the last steps (:class:`StartHistory`); ``y0`` itself
+        where the history does not reach."""
+        if self.variant != "stabilized":
+            return y0
+        n_u, n_c = self.n_u, self.n_c
+        found = self.history.predict(y0, p, n_u, self.mode, tol)
+        if found is None:
+            return y0
+        y = y0.copy()
+        y[n_u + n_c : n_u + 2 * n_c], y[:n_u] = found[0], y[:n_u] + found[1]
+        return y
+
+    def secant(self, z: np.ndarray, step: np.ndarray, weights: np.ndarray) -> np.ndarray:
+        """The Newton update ``z = -H F(y)`` (``H`` the inverse iteration matrix, :meth:`solve`)
+        after the update ``step = -H F(y - step)``, corrected by Broyden's secant update of
+        ``H`` (the "good" one, in the norm ``weights``: the tolerances' scaling), which is kept
+        for the later iterations and steps until the next factorization: ``H <- (I + s
+        step^T W / |step|^2) H`` with ``s`` the corrected update (Kelley's product form).
+
+        With the step matrix factorized whole and kept over steps (:attr:`direct`), what the
+        kept matrix misses is mostly a few directions (on the seed's complete scene, the
+        torsion of the wire's cross-sections near the contact, whose small stiffness turns a
+        slight drift of their coupling terms into an overshooting update). A secant update
+        learns them from the iterations themselves: fewer slow iterations and refactorizations.
+        At most :data:`MAX_SECANTS` updates, and none whose denominator would amplify ``z``
+        more than :data:`SECANT_GAIN` times."""
+        if not self.direct or self._secants.k >= MAX_SECANTS:
+            return z
+        s_weighted = step * weights
+        norm = float(s_weighted @ step)
+        if not norm > 0:
+            return z
+        c = s_weighted / norm
+        denominator = 1.0 - float(c @ z)
+        if abs(denominator) < 1.0 / SECANT_GAIN:
+            return z
+        s = z / denominator
+        self._secants.add(s, c)
+        return s
+
     def keeps_coupling(self, p) -> bool:
         """Whether the next step may keep the rest's coupling prepared at an earlier step: a
         rest of many unknowns (:data:`DENSE_CAPACITANCE`, or a step matrix factorized whole: a
         vehicle's bodies and contacts, whose Jacobian and sparse factorization cost several
         residuals and change little from step to step), the same step size and open contacts, and a last step that converged in
-        at most :data:`KEPT_ITERATIONS` iterations. A rest of a few pantograph unknowns on a
+        at most :data:`KEPT_ITERATIONS` iterations (:data:`DIRECT_KEPT_ITERATIONS` for a step
+        matrix factorized whole). A rest of a few pantograph unknowns on a
         line is prepared every step: its contact crosses elements, and a kept coupling cost
         more iterations than it saved."""
-        if self._prepared is None or self.last_iterations > KEPT_ITERATIONS:
+        most = DIRECT_KEPT_ITERATIONS if self.direct else KEPT_ITERATIONS
+        if self._prepared is None or self.last_iterations > most:
             return False
         bh2, mode = self._prepared
         return bh2 == float(p[3 * self.n_u + 1]) and np.array_equal(mode, self.mode)
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
-        """``J^-1 rhs`` with ``J = P + E_K Delta E_K^T`` (Woodbury), or by the factorized ``J``."""
+        """``J^-1 rhs`` with ``J = P + E_K Delta E_K^T`` (Woodbury), or by the factorized ``J``
+        and its secant updates (:meth:`secant`)."""
         if self.direct:
-            return self._coupling.solve(rhs)
+            return self._secants.apply(self._coupling.solve(rhs))
         keys, n_t, delta, z_bulk, cap = self._coupling
         n_b = self.bulk.n_b
         x = rhs.copy()
@@ -414,10 +587,13 @@ class StepEquations:
 
 
 def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: bool = False):
-    """Modified Newton iteration of one step from the predictor ``y0``, with the bulk matrix
-    kept and the rest's exact Jacobian at the predictor: when the iteration contracts by less
-    than :data:`SLOW_CONTRACTION` per iteration the rest is re-evaluated at the current iterate,
-    the second time the bulk is refactorized there. Converged when the last update, with the
+    """Modified Newton iteration of one step from the predictor ``y0`` (with ``nu`` from the
+    last steps, :meth:`StepEquations.start`), with the bulk matrix kept and the rest's exact
+    Jacobian at the predictor: when the iteration contracts by less than
+    :data:`SLOW_CONTRACTION` per iteration the rest is re-evaluated at the current iterate,
+    the second time the bulk is refactorized there (a step matrix factorized whole: kept over
+    steps with secant updates, and updated by the thresholds of :data:`DIRECT_SLOW_CONTRACTION`).
+    Converged when the last update, with the
     remaining error estimated from the contraction rate, is below ``tol``: an absolute
     tolerance on the coordinates and contact arc lengths (m, or the dimensionless slopes and
     Euler parameters), so that it means the same anywhere along a line (a tolerance relative to
@@ -426,7 +602,7 @@ def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: 
     cause on a mass ``m`` (the mean diagonal of ``M``), and ``nu`` as a position change.
     Returns ``(y, a, v, v_dot)`` or None."""
     n_u, n_c = st.n_u, st.n_c
-    y = y0.copy()
+    y = st.start(y0, p, tol).copy()
     bh2 = float(p[3 * n_u + 1])
     fresh = refreshed
     if not st.bulk.valid_for(bh2) or st.mass_scale is None:
@@ -436,12 +612,20 @@ def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: 
         st.prepare(y, p)
     scale = np.full_like(y, tol)
     scale[n_u : n_u + n_c] = tol * st.mass_scale
+    weights = scale**-2
+    # the contraction below which the iteration updates its matrix, at the second update and later
+    slow_contraction = ((0.0, DIRECT_FIRST_CONTRACTION, DIRECT_SLOW_CONTRACTION) if st.direct else
+                        (0.0, SLOW_CONTRACTION, SLOW_CONTRACTION))
     previous = None
+    step = None  # the last update, made with the current iteration matrix (see StepEquations.secant)
     slow = 0
     st.last_iterations = max_iterations + 1  # unless it converges
     for iteration in range(max_iterations):
         r = st.residual(y, p)
         dy = st.solve(-r)
+        if step is not None:
+            dy = st.secant(dy, step, weights)
+        step = dy
         y += dy
         stats["newton_iterations"] += 1
         err = np.abs(dy / scale).max(initial=0.0)
@@ -450,8 +634,11 @@ def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: 
             return None
         if err <= 1.0 and theta < 1.0 and theta / (1.0 - theta) * err <= 1.0 or err <= 1e-3:
             st.last_iterations = iteration + 1
-            return (y, *st.update(y, p))
-        if previous is not None and theta > SLOW_CONTRACTION:
+            a, v, v_dot = st.update(y, p)
+            if st.variant == "stabilized":
+                st.history.converged(a, y[n_u + n_c : n_u + 2 * n_c], st.last_shift, p, n_u, st.mode)
+            return y, a, v, v_dot
+        if previous is not None and theta > slow_contraction[min(iteration, 2)]:
             if fresh and theta >= 1.0:
                 return None  # diverging with an up-to-date matrix
             slow += 1
@@ -460,7 +647,7 @@ def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: 
             else:
                 st.factorize(y, p)
                 fresh = True
-            previous = None
+            previous = step = None
             continue
         previous = err
     if not fresh:  # a last attempt with an up-to-date matrix from the predictor

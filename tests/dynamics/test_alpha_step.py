@@ -164,3 +164,87 @@ def test_kept_patterns_give_a_fresh_builds_jacobian(line):
     p[3 * used.n_u + 1 :] *= [0.25, 0.5, 1.0]  # half the step
     ja, jb = used.jacobian(y, p), fresh.jacobian(y, p)
     assert abs(ja - jb).max() <= 1e-12 * abs(jb).max()
+
+
+def test_whole_bulk_residual_equals_the_pieces():
+    """The bulk residual as one expanded function (:class:`~symcat.integrate.alpha_bulk.Bulk`
+    with ``whole``, for step matrices factorized whole) equals its evaluation in pieces, with
+    and without a stabilization shift."""
+    from symcat.integrate.alpha_bulk import Bulk
+
+    form_found = find_form(benchmark2015(2), 6, progress=False)
+    model = MultibodyModel(catenary_scene(form_found))
+    form = Formulation(model, "augmented", "1")
+    n_u = form.n_f + form.n_s
+    pieces, whole = Bulk(form, n_u, True), Bulk(form, n_u, True, whole=True)
+    n_b = pieces.n_b
+    rng = np.random.default_rng(5)
+    c, h = AlphaCoefficients(0.8), 1e-3
+    u0 = model.q0[model.free]
+    p = np.r_[u0, rng.normal(0, 1e-2, n_u), rng.normal(0, 1.0, n_u), 0.3, c.beta * h * h, c.gamma * h,
+              (1 - c.alpha_m) / (1 - c.alpha_f)]
+    y_b = u0[:n_b] + rng.normal(0, 1e-4, n_b)
+    for shift in (np.zeros(n_b), rng.normal(0, 1e-7, n_b)):
+        expected = pieces.residual(y_b, p, shift)
+        assert np.abs(whole.residual(y_b, p, shift) - expected).max() < 1e-9 * np.abs(expected).max()
+
+
+def test_secants_apply_the_product_form():
+    """:class:`Secants` applies ``(I + s_k c_k^T) ... (I + s_1 c_1^T) z`` at once, as the
+    updates applied one after another."""
+    from symcat.integrate.alpha_step import MAX_SECANTS, Secants
+
+    rng = np.random.default_rng(3)
+    n = 30
+    sec = Secants(n)
+    pairs = [(rng.normal(size=n), rng.normal(size=n) / n) for _ in range(MAX_SECANTS)]
+    z0 = rng.normal(size=n)
+    for k, (s, c) in enumerate(pairs):
+        sec.add(s, c)
+        z = z0.copy()
+        for s_j, c_j in pairs[: k + 1]:
+            z = z + s_j * (c_j @ z)
+        np.testing.assert_allclose(sec.apply(z0), z, rtol=1e-10, atol=1e-10 * np.abs(z).max())
+    sec.clear()
+    assert np.array_equal(sec.apply(z0), z0)
+
+
+def test_start_history_extrapolates_only_a_continued_chain():
+    """:class:`StartHistory` extrapolates ``nu`` and the shift linearly when the step's predictor
+    continues its last two steps (the integrator's linear prediction of ``a`` from them), and
+    starts over otherwise (another step size, or a state it did not end with)."""
+    from symcat.integrate.alpha_step import StartHistory
+
+    n_u, tol, bh2 = 4, 1e-8, 2.5e-7
+    rng = np.random.default_rng(9)
+    mode = np.zeros(2)
+    hist = StartHistory()
+
+    def p_of(bh2_):
+        return np.r_[rng.normal(size=3 * n_u), 0.0, bh2_, 1e-3, 1.0]
+
+    a = [rng.normal(size=n_u) for _ in range(3)]
+    nu = [np.full(3, k + 1.0) for k in range(3)]
+    shift = [np.full(n_u, 10.0 * (k + 1)) for k in range(3)]
+    for k in range(2):  # two steps: a chain of two
+        p = p_of(bh2)
+        assert hist.predict(p[:n_u].copy(), p, n_u, mode, tol) is None
+        hist.converged(a[k], nu[k], shift[k], p, n_u, mode)
+    p = p_of(bh2)
+    y0 = p[:n_u] + bh2 * (a[1] + (a[1] - a[0]))  # the integrator's predictor from the chain's end
+    nu_pred, shift_pred = hist.predict(y0, p, n_u, mode, tol)
+    np.testing.assert_allclose(nu_pred, 3.0)
+    np.testing.assert_allclose(shift_pred, 30.0)
+    hist.converged(a[2], nu[2], shift[2], p, n_u, mode)
+    # a state the chain did not end with (a restart): no extrapolation, and the chain starts over
+    p = p_of(bh2)
+    assert hist.predict(p[:n_u] + bh2 * a[2], p, n_u, mode, tol) is None
+    assert hist.a == [] and hist.key is None
+    # another step size
+    for k in range(2):
+        p = p_of(bh2)
+        hist.predict(p[:n_u].copy(), p, n_u, mode, tol)
+        hist.converged(a[k], nu[k], shift[k], p, n_u, mode)
+    assert len(hist.a) == 2
+    p = p_of(bh2 / 4)
+    assert hist.predict(p[:n_u] + bh2 / 4 * (a[1] + (a[1] - a[0])), p, n_u, mode, tol) is None
