@@ -23,7 +23,7 @@ its vehicle, or no wire at all) the whole step matrix is factorized instead (spa
 rest of many unknowns keeps its factorization over the steps while Newton converges fast
 (:meth:`StepEquations.keeps_coupling`), improved in between by Broyden's secant updates
 (:meth:`StepEquations.secant`). Under the stabilized form the iteration starts from the
-multipliers ``nu`` extrapolated from the last steps (:class:`StartHistory`).
+multipliers ``nu`` extrapolated from the last steps (:class:`.alpha_history.StartHistory`).
 
 This is how dedicated pantograph/catenary codes keep a constant iteration matrix while the
 contact point moves; refactorizing a 7,000-unknown line whenever the contact crosses an element,
@@ -42,9 +42,11 @@ from ..codegen.library import BufferedFunction, symbolic_kernels
 from ..dae.formulation import Formulation
 from ..errors import SolverError
 from .alpha_bulk import Bulk, step_data
+from .alpha_history import StartHistory
 from .alpha_placement import Placement, Terms, csc_pattern, identity, output_maps, weighted_sum
 from .alpha_proxies import Proxies
 from .alpha_rest import compiled_rest, expanded_rest
+from .alpha_secant import MAX_SECANTS, Secants
 
 #: Unknowns of the rest above which its capacitance is factorized sparse (a vehicle's bodies,
 #: joints and contacts: hundreds of unknowns, a few nonzeros per row) instead of dense.
@@ -71,109 +73,12 @@ DIRECT_KEPT_ITERATIONS = 5
 #: ordering, so faster solves) and threshold partial pivoting that keeps a diagonal pivot within
 #: a factor 10 of its column's largest entry.
 DIRECT_LU = {"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.1}
-#: Broyden updates of a kept step matrix at most (:meth:`StepEquations.secant`).
-MAX_SECANTS = 20
 #: A secant update that would scale the Newton update by more than this is skipped.
 SECANT_GAIN = 10.0
 
 _GETRS = sla.get_lapack_funcs("getrs", dtype=np.float64)
 _SINGULAR = ("generalized-alpha: singular iteration matrix (redundant constraints, or a sliding joint at a point "
              "where its wire has no tangent?)")
-
-
-class StartHistory:
-    """The stabilization multipliers ``nu`` and the positions' shifts ``G^T nu`` of the last
-    two converged steps of equal size (a *chain*: each step started where the one before
-    ended), from which :meth:`StepEquations.start` extrapolates them for the Newton
-    iteration's start (the shift extrapolated too: evaluating it at the start cost a rest
-    evaluation per step for a start guess).
-
-    ``nu`` corrects the positions' drift from the velocity constraints: it is not small
-    against the Newton tolerance, but it changes smoothly from step to step, whereas the
-    integrator's predictor (``nu = 0``) puts all of it, and its shift of the positions, into
-    the first update.
-
-    The chain continues into a step only when the integrator's own (linear) prediction of
-    ``a`` is the one from the chain's last two accelerations: the same step size, and not
-    after a restart, a halving or a call redone from an earlier state. (``a`` itself is left to
-    the integrator's predictor: extrapolated to higher orders it predicted the seed's complete
-    scene closer, yet cost more refactorizations, the kept matrix's error in the wire's soft
-    torsion showing more.)"""
-
-    def __init__(self):
-        self.clear()
-
-    def clear(self) -> None:
-        self.key = None  # beta h^2 of the chain's steps
-        self.a: list = []
-        self.nu: list = []
-        self.shift: list = []
-        self.mode = None  # the open flags of the chain's last step
-        self.continues = False  # the step under way continues the chain
-
-    def predict(self, y0, p, n_u: int, mode, tol: float):
-        """``(nu, shift)`` extrapolated for the step of data ``p`` whose integrator's predictor
-        is ``y0`` (None where the chain does not reach: shorter than two steps, another step
-        size or other open contacts, or not continuing into this step)."""
-        bh2 = float(p[3 * n_u + 1])
-        self.continues = False
-        if self.key != bh2 or len(self.a) < 2:
-            # a chain of one step cannot be checked: it continues unchecked (the next step checks it)
-            self.continues = self.key == bh2 and len(self.a) == 1
-            return None
-        a = self.a
-        u_pred = p[:n_u]
-        # to the rounding of u_pred (the coordinates far down a line are large)
-        off = np.abs(y0[:n_u] - u_pred - bh2 * (a[-1] + (a[-1] - a[-2]))) - 1e-14 * np.abs(u_pred)
-        if off.max() > 1e-6 * tol:
-            self.clear()  # the state is not the chain's last (a restart, a redo or a halving)
-            return None
-        self.continues = True
-        if len(self.nu) < 2 or not np.array_equal(self.mode, mode):
-            return None
-        return 2.0 * self.nu[-1] - self.nu[-2], 2.0 * self.shift[-1] - self.shift[-2]
-
-    def converged(self, a, nu, shift, p, n_u: int, mode) -> None:
-        """Add the converged step's ``a``, ``nu`` and ``shift``."""
-        if not self.continues:
-            self.clear()
-            self.key = float(p[3 * n_u + 1])
-        self.a = (self.a + [a.copy()])[-2:]
-        self.nu = (self.nu + [nu.copy()])[-2:]
-        self.shift = (self.shift + [shift])[-2:]
-        self.mode = mode.copy()
-        self.continues = False
-
-
-class Secants:
-    """Broyden's updates of an inverse matrix ``H_0`` in product form, ``H = (I + s_k c_k^T)
-    ... (I + s_1 c_1^T) H_0`` (:meth:`StepEquations.secant`), applied at once: with ``z_0 = H_0
-    v``, ``H v = z_0 + S^T alpha`` where ``alpha`` solves the unit lower triangular ``alpha_j -
-    sum_{i<j} (c_j^T s_i) alpha_i = c_j^T z_0``, whose inverse is kept (a few products with
-    small matrices instead of ``k`` pairs of vector operations)."""
-
-    def __init__(self, n: int):
-        self.s = np.zeros((MAX_SECANTS, n))
-        self.c = np.zeros((MAX_SECANTS, n))
-        self.inverse = np.zeros((MAX_SECANTS, MAX_SECANTS))  # of the triangular matrix above
-        self.k = 0
-
-    def clear(self) -> None:
-        self.k = 0
-
-    def add(self, s: np.ndarray, c: np.ndarray) -> None:
-        k = self.k
-        self.s[k], self.c[k] = s, c
-        # [[L, 0], [l^T, 1]]^-1 = [[L^-1, 0], [-l^T L^-1, 1]] with l_i = -c^T s_i
-        self.inverse[k, :k] = (self.s[:k] @ c) @ self.inverse[:k, :k]
-        self.inverse[k, k] = 1.0
-        self.k = k + 1
-
-    def apply(self, z0: np.ndarray) -> np.ndarray:
-        k = self.k
-        if not k:
-            return z0
-        return z0 + (self.inverse[:k, :k] @ (self.c[:k] @ z0)) @ self.s[:k]
 
 
 class StepEquations:
@@ -511,7 +416,7 @@ class StepEquations:
     def start(self, y0, p, tol: float) -> np.ndarray:
         """The Newton iteration's start from the integrator's predictor ``y0``: under the
         stabilized form, ``nu`` and the positions' shift ``G^T nu`` (which the converged
-        positions hold) extrapolated from the last steps (:class:`StartHistory`); ``y0`` itself
+        positions hold) extrapolated from the last steps (:class:`.alpha_history.StartHistory`); ``y0`` itself
         where the history does not reach."""
         if self.variant != "stabilized":
             return y0
@@ -535,7 +440,7 @@ class StepEquations:
         torsion of the wire's cross-sections near the contact, whose small stiffness turns a
         slight drift of their coupling terms into an overshooting update). A secant update
         learns them from the iterations themselves: fewer slow iterations and refactorizations.
-        At most :data:`MAX_SECANTS` updates, and none whose denominator would amplify ``z``
+        At most :data:`.alpha_secant.MAX_SECANTS` updates, and none whose denominator would amplify ``z``
         more than :data:`SECANT_GAIN` times."""
         if not self.direct or self._secants.k >= MAX_SECANTS:
             return z

@@ -192,7 +192,7 @@ def test_whole_bulk_residual_equals_the_pieces():
 def test_secants_apply_the_product_form():
     """:class:`Secants` applies ``(I + s_k c_k^T) ... (I + s_1 c_1^T) z`` at once, as the
     updates applied one after another."""
-    from symcat.integrate.alpha_step import MAX_SECANTS, Secants
+    from symcat.integrate.alpha_secant import MAX_SECANTS, Secants
 
     rng = np.random.default_rng(3)
     n = 30
@@ -213,7 +213,7 @@ def test_start_history_extrapolates_only_a_continued_chain():
     """:class:`StartHistory` extrapolates ``nu`` and the shift linearly when the step's predictor
     continues its last two steps (the integrator's linear prediction of ``a`` from them), and
     starts over otherwise (another step size, or a state it did not end with)."""
-    from symcat.integrate.alpha_step import StartHistory
+    from symcat.integrate.alpha_history import StartHistory
 
     n_u, tol, bh2 = 4, 1e-8, 2.5e-7
     rng = np.random.default_rng(9)
