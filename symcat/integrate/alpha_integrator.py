@@ -153,7 +153,7 @@ class Integrator:
     def move_windows(self, s: State) -> bool:
         """Move the element windows with their points at ``s``; True if the step's equations
         were rebuilt (without proxy elements the windows are part of their graph)."""
-        if self.stepper.proxies is not None:
+        if self.stepper.proxies is not None or not self.model.windows_move():
             return False
         x, z = self.layout(s)
         if not update_windows(self.model, self.form, x, z):
