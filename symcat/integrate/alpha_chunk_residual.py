@@ -146,6 +146,8 @@ class ChunkResidual:
         """Each column of ``matrix`` with each proxy's entries added to its actual element's
         (the substitution's transpose) and removed from its places."""
         size, m = matrix.shape
+        if not m or not size:  # nothing to move (the index-3 form's shift derivatives: no nu)
+            return matrix
         values = [matrix[places.tolist(), :] for places, _, _ in terms]
         for places, _, _ in terms:
             matrix = _set(matrix, places, ca.MX.zeros(places.size, m))
