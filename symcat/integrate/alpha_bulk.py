@@ -291,7 +291,7 @@ class _BulkForces:
             if picked is not None:
                 f = np.zeros(y_b.size)
                 for fn, at, free, fixed, to in self._gathers:
-                    values = fn(fixed + np.where(free, y_b[at], 0.0), np.where(free, v_b[at], 0.0), t)[0].ravel()
+                    values = fn.nonzeros(fixed + np.where(free, y_b[at], 0.0), np.where(free, v_b[at], 0.0), t)[0]
                     f += np.bincount(to, values[free], minlength=y_b.size)
                 return f
         if picked is None:
@@ -302,9 +302,10 @@ class _BulkForces:
             v[picked] = v_b
         f = np.zeros(self._n_q)
         if self.stiffness is None:
-            f[: self._n_a] = self._ancf(q[: self._n_a], v[: self._n_a])[0].ravel()
+            # (dense outputs: their nonzeros are the vector, no scatter into a new array)
+            f[: self._n_a] = self._ancf.nonzeros(q[: self._n_a], v[: self._n_a])[0]
         for fn, flat in self._groups:
-            f += np.bincount(flat, fn(q[flat], v[flat], t)[0].ravel(), minlength=self._n_q)
+            f += np.bincount(flat, fn.nonzeros(q[flat], v[flat], t)[0], minlength=self._n_q)
         return self._to_free @ f if picked is None else f[picked]
 
 
