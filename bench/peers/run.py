@@ -59,8 +59,9 @@ NOTES = [
     "compiled, up to 32 to a call, on all three dynamic problems (the sliding joint's and the moving "
     "load's points on one proxy element that the code fills with the element holding them). symcat's "
     "runs keep the integrator's own multipliers (no KKT solve per output), as Exudyn reports only its "
-    "sensors; each model's compiled library is built before the timed runs, as the kernels are (20 to "
-    "60 s once per model).",
+    "sensors; each model's compiled library is built before the timed runs, as the kernels are, in its "
+    "optimized tier (-O2; 20 to 90 s once per model; a user's first run takes the -O0 library while the "
+    "optimized one compiles in the background).",
     "- **IDAS on the moving load and the pendulum**: the error does not change with rtol (1e-5 to 2e-5 m): "
     "it is the distance between IDAS's solution and symcat's generalized-alpha reference, whose numerical "
     "dissipation (spectral radius 0.8 on the pendulum) and step leave that much; the IDAS points therefore "

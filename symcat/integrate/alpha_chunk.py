@@ -116,9 +116,7 @@ class CompiledSteps:
         if self._fns is not None:
             return True
         integ, st = self.integ, self.integ.stepper
-        if st.mass_scale is None:  # the scale of the multipliers' tolerance (a Python factorization)
-            p = integ.data(s, t, self.h)
-            st.factorize(integ.predictor(s, p, self.h), p)
+        st.scale_multipliers(s.u)  # the scale of the multipliers' tolerance
         try:
             graph = _graph(ChunkResidual(st))
             layout = _layout(st)

@@ -51,8 +51,8 @@ class ChunkResidual:
         y_b = ca.MX.sym("y_b", n_b)
         r_b = bulk_rows(form, n_b, n_u, y_b, p, shift_b) if n_b else ca.MX(0, 1)
         self._bulk = ca.Function("alpha_chunk_bulk", [y_b, p, shift_b], [r_b])
-        self._bulk_jacobian = ca.Function("alpha_chunk_bulk_jacobian", [y_b, p, shift_b],
-                                          [ca.jacobian(r_b, y_b)])
+        self._bulk_graph = (y_b, p, shift_b, r_b)
+        self._bulk_jacobian = None  # built by jacobian() (the cache key needs the rows only)
         model = form.model
         items = model.windowed()
         self.proxies = st.proxies
@@ -71,11 +71,9 @@ class ChunkResidual:
                 sl.window = window
         self._rest = ca.Function("alpha_chunk_rest", [y, p, w], [rows, shift])
         self._rest_jacobian = None
+        self._expand = expand
         if expand:
             self._bulk, self._rest = merged(self._bulk.expand()), merged(self._rest.expand())
-            expanded = self._bulk_jacobian.expand()
-            if expanded.n_instructions() <= EXPANDED_JACOBIAN:
-                self._bulk_jacobian = merged(expanded)
             # The rest's border in scalar operations, differentiated where its entries depend
             # on the unknowns: CasADi's derivative of a call in all directions would be the
             # rest's code as many times over as there are directions.
@@ -86,6 +84,20 @@ class ChunkResidual:
                 ca.jacobian(rows_s, y_r), ca.jacobian(rows_s[n_b:], y_s[:n_b]),
                 ca.jacobian(shift_s[:n_b], y_s[self._nu]), shift_s]))
         self._tables = self._element_tables() if self.proxies is not None else []
+
+    def _wires_jacobian(self) -> ca.Function:
+        """``(y_b, p, shift_b) -> d rows_b / d y_b``, expanded (with ``expand``) up to
+        :data:`EXPANDED_JACOBIAN` operations."""
+        if self._bulk_jacobian is None:
+            # differentiated over the kernels' graph (their own stiffness functions), then expanded
+            y_b, p, shift_b, r_b = self._bulk_graph
+            fn = ca.Function("alpha_chunk_bulk_jacobian", [y_b, p, shift_b], [ca.jacobian(r_b, y_b)])
+            if self._expand:
+                expanded = fn.expand()
+                if expanded.n_instructions() <= EXPANDED_JACOBIAN:
+                    fn = merged(expanded)
+            self._bulk_jacobian = fn
+        return self._bulk_jacobian
 
     # --- the proxies' substitution ----------------------------------------------------------
     def _element_tables(self):
@@ -199,7 +211,7 @@ class ChunkResidual:
             j_cols, j_rows, d_shift, shift = self._rest_jacobian(y, p, ca.MX(0, 1))
         if not n_b:
             return j_cols
-        j_bb = self._bulk_jacobian(y_b, p, shift[:n_b]) if wires else ca.MX(n_b, n_b)
+        j_bb = self._wires_jacobian()(y_b, p, shift[:n_b]) if wires else ca.MX(n_b, n_b)
         # the wires' rows through the stabilization's shift of their accelerations (the
         # velocity multipliers' columns): -(c_m M + gamma h C) G^T, with the constant mass and
         # Rayleigh matrices (the shift's arc-length derivative, nu times a curvature, left out)

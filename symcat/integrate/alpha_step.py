@@ -206,7 +206,7 @@ class StepEquations:
         sc = y[n_y - n_sc :] if n_sc else None
         q, s = u[:n_f], u[n_f:]
         shift = ca.MX(n_u, 1)
-        if variant == "stabilized":
+        if variant == "stabilized" and n_c:  # (no constraints: no shift, and no graph of the terms for it)
             nu = y[n_u + n_c : n_u + 2 * n_c]
             # C_q and C_s depend on positions only: the velocities of this probe are immaterial.
             g = self._terms(form, q, ca.MX.zeros(n_f), s, ca.MX.zeros(n_s), t, sc, part)
@@ -220,7 +220,7 @@ class StepEquations:
             dyn -= form.creep_force(k, s, v[n_f:], lam_s / bh2)[0]
         rows = [bh2 * dyn + ca.mtimes(k["Cq"].T, lam_s), ca.mtimes(k["Cs"].T, lam_s),
                 form._release(k["C"], lam_s, mode)]
-        if variant == "stabilized":
+        if variant == "stabilized" and n_c:
             c_dot = bh2 / gh * (ca.mtimes(k["Cq"], v[:n_f]) + ca.mtimes(k["Cs"], v[n_f:]) + k["Ct"])
             rows.append(form._release(c_dot, nu, mode))
         rows.append(k["T"])
@@ -353,13 +353,18 @@ class StepEquations:
         return jac
 
     # --- the linear solve ---------------------------------------------------------------------
-    def factorize(self, y, p) -> None:
-        """Refactorize the bulk matrix at ``(y, p)`` and prepare the rest's coupling there."""
+    def scale_multipliers(self, y) -> float:
+        """:attr:`mass_scale`, set at ``y`` if not yet: the mean of the mass matrix's own
+        diagonal (the iteration matrix's also holds beta h^2 K, which on the stiff
+        cross-section gradients of a beam3d wire exceeds the mass by orders)."""
         if self.mass_scale is None:
-            # The mass matrix's own diagonal: the iteration matrix's also holds beta h^2 K, which
-            # on the stiff cross-section gradients of a beam3d wire exceeds the mass by orders.
             diag = np.abs(self.mass(y).diagonal())
             self.mass_scale = float(diag.mean()) if diag.size and diag.mean() > 0 else 1.0
+        return self.mass_scale
+
+    def factorize(self, y, p) -> None:
+        """Refactorize the bulk matrix at ``(y, p)`` and prepare the rest's coupling there."""
+        self.scale_multipliers(y)
         if self.direct:  # prepare factorizes everything
             self.bulk.lu, self.bulk.bh2 = True, float(p[3 * self.n_u + 1])
         else:
