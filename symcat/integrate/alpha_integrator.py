@@ -175,16 +175,14 @@ class Integrator:
 
     def layout(self, s: State):
         """The state in the augmented index-1 layout ``x = [q, s, v, w]``, ``z = [a, s_dd, lambda(, sc)]``."""
+        if not hasattr(self, "_order"):  # the blocks' order in x and z, by name (once: called at every output)
+            self._order = [[name for name, _ in sorted(blocks.items(), key=lambda item: item[1].slice.start)]
+                           for blocks in (self.xb, self.zb)]
         n_f = self.form.n_f
         values = {"q": s.u[:n_f], "s": s.u[n_f:], "v": s.v[:n_f], "w": s.v[n_f:], "a": s.v_dot[:n_f],
                   "s_dd": s.v_dot[n_f:], "lambda": s.lam, "sc": s.sc}
-        x = np.zeros(sum(blk.size for blk in self.xb.values()))
-        z = np.zeros(sum(blk.size for blk in self.zb.values()))
-        for name, blk in self.xb.items():
-            x[blk.slice] = values[name]
-        for name, blk in self.zb.items():
-            z[blk.slice] = values[name]
-        return x, z
+        return tuple(np.concatenate([values[name] for name in order]) if order else np.zeros(0)
+                     for order in self._order)
 
     def start(self, x, z, h: float) -> State:
         """The state of the consistent ``(x, z)`` at t = 0, with the starting value of ``a``
