@@ -20,6 +20,16 @@ def rng():
     return np.random.default_rng(20261121)
 
 
+def pytest_xdist_auto_num_workers(config):
+    """``-n auto`` (``make test``): one worker per CPU this process may run on, hyperthreads
+    and a container's CPU set included (``os.sched_getaffinity``). pytest-xdist itself counts
+    physical cores, one on a machine of two hyperthreads: no parallel run at all.
+    ``PYTEST_XDIST_AUTO_NUM_WORKERS`` still sets the number."""
+    if os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS") or not hasattr(os, "sched_getaffinity"):
+        return None  # pytest-xdist decides
+    return max(1, len(os.sched_getaffinity(0)))
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     """The files that hold a test marked ``slow`` first (otherwise as collected): ``make test``
