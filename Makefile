@@ -25,8 +25,10 @@ check-generated: install
 compile: install
 	$(PY) -m symcat.codegen compile
 
+## Every test, in parallel on all cores (pytest-xdist), a test file at a time (its module fixtures
+## built once), the files with slow tests first (tests/conftest.py). PYTEST_ARGS: more options.
 test: install compile
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n auto --dist loadfile --no-loadscope-reorder $(PYTEST_ARGS)
 
 bench: install compile
 	$(PY) -m bench.run

@@ -112,7 +112,8 @@ DYNAMIC = [
 ]
 
 
-@pytest.mark.parametrize("name, values", DYNAMIC, ids=[d[0] for d in DYNAMIC])
+@pytest.mark.parametrize("name, values", [pytest.param(name, values, id=name, marks=[pytest.mark.slow] * (name == "vehicle"))
+                                          for name, values in DYNAMIC])
 def test_dynamic_model_writes_a_paraview_series_whose_frames_load(tmp_path, name, values):
     res = run_model(name, values, out=tmp_path)
     pvd = tmp_path / "paraview" / f"{name}.pvd"

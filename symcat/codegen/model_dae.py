@@ -6,13 +6,16 @@ sparse products run by CasADi's virtual machine: 4 to 8 ms for the seed vehicle 
 7745 nonzeros). The same DAE built over the kernels' SX expressions (:func:`symbolic_kernels`),
 expanded to one SX function, differentiated in SX and compiled costs 0.3 ms, and its residual
 0.1 ms instead of 0.2 to 0.4 (``python -m bench.model_dae`` measures both). The library is
-cached under a key of the expanded function, so a model is compiled once per machine.
+cached under a key of the expanded function, so a model is compiled once per machine: processes
+that need the same library at the same time (parallel test workers, runs of a study) compile it
+once, the others wait for it (:func:`_compiling`).
 """
 from __future__ import annotations
 
 import logging
 import tempfile
 import time
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable
 
@@ -84,20 +87,42 @@ def compiled_library(name: str, key: bytes, write_c: Callable[[Path], Path], mod
     if not build:
         return target if target.exists() else plain if plain.exists() else None
     if not target.exists():
-        t0 = time.perf_counter()
-        with tempfile.TemporaryDirectory() as tmp:
-            notice(f"compiling this model's equations with the C compiler (once per machine and model; cached in {target.parent})")
-            c_path = write_c(Path(tmp))
-            if mode == "now":
-                log.info("compiling %s optimized (about 30 s for the seed vehicle's DAE)", name)
-            build_library(find_compiler(), flags, c_path, target)
-            if mode == "background" and not optimized.exists():
-                atomic_write(source_path(optimized), c_path.read_bytes())
-        COMPILED["n"] += 1
-        COMPILED["seconds"] += time.perf_counter() - t0
+        with _compiling(target):
+            if not target.exists():  # not compiled by the process this one waited for
+                t0 = time.perf_counter()
+                with tempfile.TemporaryDirectory() as tmp:
+                    notice(f"compiling this model's equations with the C compiler (once per machine and model; cached in {target.parent})")
+                    c_path = write_c(Path(tmp))
+                    if mode == "now":
+                        log.info("compiling %s optimized (about 30 s for the seed vehicle's DAE)", name)
+                    build_library(find_compiler(), flags, c_path, target)
+                    if mode == "background" and not optimized.exists():
+                        atomic_write(source_path(optimized), c_path.read_bytes())
+                COMPILED["n"] += 1
+                COMPILED["seconds"] += time.perf_counter() - t0
     if mode == "background" and source_path(optimized).exists():  # also a job that died
         start_background(optimized, optimized_flags)
     return target
+
+
+@contextmanager
+def _compiling(target: Path):
+    """Held while this process compiles ``target``: an exclusive lock on ``<target>.compiling``
+    (released by the system if the process dies), so that another process needing the same
+    library waits for it instead of compiling it a second time. Without ``fcntl`` (not POSIX)
+    nothing is held: both compile, and :func:`os.replace` installs either intact library."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    target.parent.mkdir(parents=True, exist_ok=True)
+    with open(target.with_suffix(".compiling"), "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 def write_dae_c(build: Callable[[], ca.Function], name: str, folder: Path) -> Path:

@@ -159,3 +159,38 @@ def test_stale_shipped_code_is_regenerated_into_the_cache_not_the_source_tree(tm
     again = subprocess.run([sys.executable, "-c", code + "; import sys; print(int('sympy' in sys.modules))"],
                            capture_output=True, text=True, cwd=ROOT, env=env)
     assert again.returncode == 0 and again.stdout.split()[-1] == "0" and "regenerating" not in again.stderr
+
+
+def test_processes_needing_the_same_model_library_at_once_compile_it_once(tmp_path):
+    """Two processes (as parallel test workers) ask for the same uncached model library at the
+    same moment: one compiles it while the other waits for it, and both load it."""
+    code = (
+        "import sys, time\n"
+        "from pathlib import Path\n"
+        "import casadi as ca\n"
+        "from symcat.codegen import model_dae\n"
+        "from symcat.codegen.library import write_functions_c\n"
+        "x = ca.SX.sym('x')\n"
+        "tiny = ca.Function('tiny', [x], [x * x + 1])\n"
+        "def write(folder):\n"
+        "    time.sleep(1.0)  # a slow generation: the other process arrives meanwhile\n"
+        "    return write_functions_c([tiny], 'tiny', folder)\n"
+        "go = Path(sys.argv[1])\n"
+        "print('ready', flush=True)\n"
+        "while not go.exists():\n"
+        "    time.sleep(0.01)\n"
+        "path = model_dae.compiled_library('tiny', b'tiny', write, 'off')\n"
+        "print(model_dae.COMPILED['n'], float(ca.external('tiny', str(path))(3.0)), path)\n"
+    )
+    go = tmp_path / "go"
+    env = {**os.environ, "SYMCAT_CACHE": str(tmp_path / "cache")}
+    procs = [subprocess.Popen([sys.executable, "-c", code, str(go)], env=env, cwd=ROOT, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    for p in procs:
+        assert p.stdout.readline().strip() == "ready", p.stderr.read()
+    go.touch()
+    outs = [p.communicate()[0].split() for p in procs]
+    assert all(p.returncode == 0 for p in procs), [p.stderr for p in procs]
+    assert sorted(int(out[0]) for out in outs) == [0, 1]  # compiled once
+    assert [out[1] for out in outs] == ["10.0", "10.0"] and outs[0][2] == outs[1][2]
+    assert [p.name for p in (tmp_path / "cache").glob("*.so")] == [Path(outs[0][2]).name]

@@ -88,6 +88,7 @@ def test_bad_irregularity_file_names_the_parameter(tmp_path, content, match):
         run_model("wheelset", {"irregularity_file": str(path), "t_end": 0.1})
 
 
+@pytest.mark.slow
 def test_vehicle_model_on_a_layout_without_irregularities_runs_as_on_ideal_track(tmp_path):
     """``irregularity_file`` of the vehicle model puts the vehicle on a tangent layout: with an
     all-zero file it runs as on the ideal track (wheelsets' positions to 1e-14 m, normal forces

@@ -77,6 +77,7 @@ def test_off_centre_wheel_loads_sum_to_the_weight_plus_the_vertical_momentum_rat
     assert np.abs([res.a[0, res.coordinate_names.index(f"{b}.z")] for b in others]).max() < 1e-9
 
 
+@pytest.mark.slow
 def test_centred_vehicle_stays_symmetric_at_speed_on_s1002():
     layout, res, forces = _run(profile="s1002_uic60", t_end=0.2)
     for w in layout.wheelsets:
@@ -87,6 +88,7 @@ def test_centred_vehicle_stays_symmetric_at_speed_on_s1002():
     np.testing.assert_allclose(q.sum(axis=0), layout.parameters.total_mass_kg * G, rtol=1e-4)
 
 
+@pytest.mark.slow
 def test_lateral_motion_converges_with_the_tolerance_and_does_not_depend_on_the_drive():
     """A displaced vehicle on coned wheels: the wheelsets' lateral motion at rtol 1e-7 and 1e-8 agree,
     and driving by a constraint or by traction servos gives the same motion (the drive only
@@ -104,6 +106,7 @@ def test_lateral_motion_converges_with_the_tolerance_and_does_not_depend_on_the_
     np.testing.assert_allclose(n_coarse, n_fine, rtol=1e-3)
 
 
+@pytest.mark.slow
 def test_bogies_steer_their_wheelsets_and_the_start_offset_decays():
     """Below its critical speed the vehicle damps a lateral offset out. With the equalizer bars
     free to yaw about their guides (the bug this guards), the frames could not steer the
@@ -120,6 +123,7 @@ def test_bogies_steer_their_wheelsets_and_the_start_offset_decays():
     assert np.abs(y["b1_ws1"] - y["b1_ws2"]).max() > 2e-4
 
 
+@pytest.mark.slow
 def test_global_contact_form_moves_the_vehicle_as_the_rail_frame_form():
     """Eq. 21 contacts with linear creep on all eight wheels: a vehicle displaced by 2 mm at 17
     m/s moves as with eq. 22 (wheelsets' lateral positions to 2e-11 m measured over 0.2 s;

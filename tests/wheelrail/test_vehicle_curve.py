@@ -88,6 +88,7 @@ def test_contact_frames_on_a_canted_curve_are_the_track_frames(pair, ramp, atol)
         assert np.all(np.abs(phi[1:]) > 0.03)                                         # canted: a real test
 
 
+@pytest.mark.slow
 def test_a_straight_layout_turned_in_plan_runs_as_tangent_track(pair):
     """The same displaced vehicle on tangent track and on a straight layout turned by 0.5 rad
     and shifted: lateral motion, Y and Q agree in track coordinates (the driving constraint
@@ -125,6 +126,7 @@ def _about_the_centre(res, name, centre, h):
     return rho, (np.einsum("ni,ni->n", vel, vel) - rho_dot**2) / rho - rho_ddot
 
 
+@pytest.mark.slow
 def test_steady_curving_the_rails_carry_the_centripetal_force():
     """The vehicle runs (traction servos, 15 m/s) from its lead-in through a 10 m clothoid into
     an uncanted 800 m curve to the left. The rails' forces on the wheels are the only external
@@ -187,6 +189,7 @@ def test_steady_curving_the_rails_carry_the_centripetal_force():
     assert max(np.abs(v).max() for v in y.values()) < 0.02
 
 
+@pytest.mark.slow
 def test_the_vehicle_crosses_a_smooth_cant_ramp():
     """A 100 mm cant ramped over a 10 m clothoid: with the smooth (Bloss) ramp the rails have no
     kinks, and the vehicle's leading wheelset runs from the lead-in over the whole ramp into the
