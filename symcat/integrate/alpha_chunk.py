@@ -3,7 +3,7 @@ events or per-step monitor (:func:`.generalized_alpha.integrate_alpha`).
 
 Why: on a small model (a cable pendulum of a hundred coordinates, a wire under a moving load)
 a step's arithmetic takes tens of microseconds, and the Python around each Newton iteration
-of :func:`.alpha_step.solve_step` (residual calls, SciPy factorizations and solves,
+of :func:`.alpha_newton.solve_step` (residual calls, SciPy factorizations and solves,
 bookkeeping) several hundred; stepped from Python, symcat was several times slower than a
 compiled code. Here the same steps (unknowns, scaled residual, modified Newton iteration and
 its convergence test) are one CasADi function of up to :data:`MAX_STEPS` steps, generated to
@@ -17,8 +17,8 @@ C and compiled once per model (cached on disk like the models' DAEs,
   block), factorized in the code as a band (the wires, ordered by reverse Cuthill-McKee) with a
   dense border (bodies, arc lengths, multipliers: :class:`.bordered_band.BorderedBand`), kept
   across steps; when the iteration contracts slower than
-  :data:`~.alpha_step.SLOW_CONTRACTION` its border is renewed at the current iterate, then the
-  whole matrix, as :func:`~.alpha_step.solve_step` prepares the rest, then refactorizes;
+  :data:`~.alpha_newton.SLOW_CONTRACTION` its border is renewed at the current iterate, then the
+  whole matrix, as :func:`~.alpha_newton.solve_step` prepares the rest, then refactorizes;
 - a step that fails even with a fresh matrix (divergence, :data:`MAX_ITERATIONS`, a
   non-finite update) ends the call; that step is then taken by
   :meth:`.alpha_integrator.Integrator.advance` (its own matrices, halving) and the compiled
@@ -41,7 +41,8 @@ from ..errors import CompilerError
 from .alpha_bulk import step_data
 from .alpha_chunk_residual import ChunkResidual
 from .alpha_integrator import Integrator, State
-from .alpha_step import SLOW_CONTRACTION, StepEquations
+from .alpha_newton import SLOW_CONTRACTION
+from .alpha_step import StepEquations
 from .bordered_band import BorderedBand
 
 log = logging.getLogger(__name__)

@@ -15,7 +15,8 @@ from ..dae.formulation import Formulation
 from ..dae.initial import consistent_state
 from ..errors import SolverError
 from .alpha_run import StepState
-from .alpha_step import StepEquations, solve_step
+from .alpha_newton import solve_step
+from .alpha_step import StepEquations
 from .simulate import update_windows
 
 
@@ -78,6 +79,8 @@ class Integrator:
         self.tol, self.max_iterations, self.max_halvings, self.expand = tol, max_iterations, max_halvings, expand
         self.stats = stats
         self.xb, self.zb = form.blocks()
+        # the blocks' names in their order in x and z (layout() concatenates them at every output)
+        self._order = [sorted(blocks, key=lambda name: blocks[name].start) for blocks in (self.xb, self.zb)]
         self.open_rows = []  # the constraint rows an event handler released (lifted wheels)
         self.singular_fails_step = False  # a singular iteration matrix: a failed step, not the run's end
         self.stepper = self._build()
@@ -175,9 +178,6 @@ class Integrator:
 
     def layout(self, s: State):
         """The state in the augmented index-1 layout ``x = [q, s, v, w]``, ``z = [a, s_dd, lambda(, sc)]``."""
-        if not hasattr(self, "_order"):  # the blocks' order in x and z, by name (once: called at every output)
-            self._order = [[name for name, _ in sorted(blocks.items(), key=lambda item: item[1].slice.start)]
-                           for blocks in (self.xb, self.zb)]
         n_f = self.form.n_f
         values = {"q": s.u[:n_f], "s": s.u[n_f:], "v": s.v[:n_f], "w": s.v[n_f:], "a": s.v_dot[:n_f],
                   "s_dd": s.v_dot[n_f:], "lambda": s.lam, "sc": s.sc}

@@ -6,6 +6,8 @@ import numpy as np
 
 #: Broyden updates of a kept step matrix at most (:meth:`.alpha_step.StepEquations.secant`).
 MAX_SECANTS = 20
+#: A secant update that would scale the Newton update by more than this is skipped.
+SECANT_GAIN = 10.0
 
 
 class Secants:
@@ -37,3 +39,23 @@ class Secants:
         if not k:
             return z0
         return z0 + (self.inverse[:k, :k] @ (self.c[:k] @ z0)) @ self.s[:k]
+
+    def update(self, z: np.ndarray, step: np.ndarray, weights: np.ndarray) -> np.ndarray:
+        """The Newton update ``z = -H F(y)`` after the update ``step = -H F(y - step)``,
+        corrected by Broyden's "good" update of ``H`` in the norm ``weights`` (the tolerances'
+        scaling), which is added: ``H <- (I + s step^T W / |step|^2) H`` with ``s`` the
+        corrected update (Kelley's product form). At most :data:`MAX_SECANTS` updates, and none
+        whose denominator would amplify ``z`` more than :data:`SECANT_GAIN` times."""
+        if self.k >= MAX_SECANTS:
+            return z
+        s_weighted = step * weights
+        norm = float(s_weighted @ step)
+        if not norm > 0:
+            return z
+        c = s_weighted / norm
+        denominator = 1.0 - float(c @ z)
+        if abs(denominator) < 1.0 / SECANT_GAIN:
+            return z
+        s = z / denominator
+        self.add(s, c)
+        return s

@@ -1,4 +1,5 @@
-"""The equations of one generalized-alpha step and their modified Newton solve, for
+"""The equations of one generalized-alpha step and their linear solve (the modified Newton
+iteration over them: :mod:`.alpha_newton`), for
 :mod:`symcat.integrate.generalized_alpha` (whose module docstring explains the method, the
 unknowns and the scaling).
 
@@ -46,7 +47,7 @@ from .alpha_history import StartHistory
 from .alpha_placement import Placement, Terms, csc_pattern, identity, output_maps, weighted_sum
 from .alpha_proxies import Proxies
 from .alpha_rest import compiled_rest, expanded_rest
-from .alpha_secant import MAX_SECANTS, Secants
+from .alpha_secant import Secants
 
 #: Unknowns of the rest above which its capacitance is factorized sparse (a vehicle's bodies,
 #: joints and contacts: hundreds of unknowns, a few nonzeros per row) instead of dense.
@@ -54,27 +55,15 @@ DENSE_CAPACITANCE = 200
 #: A kept coupling (:meth:`StepEquations.keeps_coupling`) is prepared afresh after a step that
 #: took more Newton iterations than this.
 KEPT_ITERATIONS = 4
-#: A Newton iteration that contracts by less than this per iteration updates its matrix.
-SLOW_CONTRACTION = 0.3
-#: With the step matrix factorized whole (:attr:`StepEquations.direct`) and kept over steps,
-#: an update of the matrix (the rest's Jacobian and a sparse LU) costs as much as some ten
-#: iterations: the iteration updates its matrix when it contracts by less than
-#: ``DIRECT_SLOW_CONTRACTION`` from its third update on, or when its second update exceeds
-#: its first by ``DIRECT_FIRST_CONTRACTION``. The first ratio is no measure of the rate: an
-#: error of the kept matrix in a soft direction (the torsion of a beam3d wire's cross-sections
-#: under the contact) shows as an overshoot in the first update that the second undoes, after
-#: which the iteration converges fast. A step after one of more than
-#: ``DIRECT_KEPT_ITERATIONS`` iterations starts from an updated matrix.
-DIRECT_SLOW_CONTRACTION = 0.5
-DIRECT_FIRST_CONTRACTION = 1.0
+#: With the step matrix factorized whole (:attr:`StepEquations.direct`) and kept over steps, a
+#: step after one of more than this many iterations starts from an updated matrix (see
+#: :data:`.alpha_newton.DIRECT_SLOW_CONTRACTION`).
 DIRECT_KEPT_ITERATIONS = 5
 #: SuperLU's options for the step matrix factorized whole: a symmetric ordering (the pattern is
 #: structurally symmetric but for the constraints' rows: less fill than the default column
 #: ordering, so faster solves) and threshold partial pivoting that keeps a diagonal pivot within
 #: a factor 10 of its column's largest entry.
 DIRECT_LU = {"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.1}
-#: A secant update that would scale the Newton update by more than this is skipped.
-SECANT_GAIN = 10.0
 
 _GETRS = sla.get_lapack_funcs("getrs", dtype=np.float64)
 _SINGULAR = ("generalized-alpha: singular iteration matrix (redundant constraints, or a sliding joint at a point "
@@ -435,31 +424,16 @@ class StepEquations:
 
     def secant(self, z: np.ndarray, step: np.ndarray, weights: np.ndarray) -> np.ndarray:
         """The Newton update ``z = -H F(y)`` (``H`` the inverse iteration matrix, :meth:`solve`)
-        after the update ``step = -H F(y - step)``, corrected by Broyden's secant update of
-        ``H`` (the "good" one, in the norm ``weights``: the tolerances' scaling), which is kept
-        for the later iterations and steps until the next factorization: ``H <- (I + s
-        step^T W / |step|^2) H`` with ``s`` the corrected update (Kelley's product form).
+        after the update ``step`` made with the same ``H``, corrected by Broyden's secant update
+        of ``H`` (:meth:`.alpha_secant.Secants.update`), kept for the later iterations and steps
+        until the next factorization.
 
         With the step matrix factorized whole and kept over steps (:attr:`direct`), what the
         kept matrix misses is mostly a few directions (on the seed's complete scene, the
         torsion of the wire's cross-sections near the contact, whose small stiffness turns a
         slight drift of their coupling terms into an overshooting update). A secant update
-        learns them from the iterations themselves: fewer slow iterations and refactorizations.
-        At most :data:`.alpha_secant.MAX_SECANTS` updates, and none whose denominator would amplify ``z``
-        more than :data:`SECANT_GAIN` times."""
-        if not self.direct or self._secants.k >= MAX_SECANTS:
-            return z
-        s_weighted = step * weights
-        norm = float(s_weighted @ step)
-        if not norm > 0:
-            return z
-        c = s_weighted / norm
-        denominator = 1.0 - float(c @ z)
-        if abs(denominator) < 1.0 / SECANT_GAIN:
-            return z
-        s = z / denominator
-        self._secants.add(s, c)
-        return s
+        learns them from the iterations themselves: fewer slow iterations and refactorizations."""
+        return self._secants.update(z, step, weights) if self.direct else z
 
     def keeps_coupling(self, p) -> bool:
         """Whether the next step may keep the rest's coupling prepared at an earlier step: a
@@ -494,74 +468,3 @@ class StepEquations:
         x[:n_b] -= z_bulk @ w[:n_t]
         x[n_b:] -= w[n_t:]
         return x
-
-
-def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: bool = False):
-    """Modified Newton iteration of one step from the predictor ``y0`` (with ``nu`` from the
-    last steps, :meth:`StepEquations.start`), with the bulk matrix kept and the rest's exact
-    Jacobian at the predictor: when the iteration contracts by less than
-    :data:`SLOW_CONTRACTION` per iteration the rest is re-evaluated at the current iterate,
-    the second time the bulk is refactorized there (a step matrix factorized whole: kept over
-    steps with secant updates, and updated by the thresholds of :data:`DIRECT_SLOW_CONTRACTION`).
-    Converged when the last update, with the
-    remaining error estimated from the contraction rate, is below ``tol``: an absolute
-    tolerance on the coordinates and contact arc lengths (m, or the dimensionless slopes and
-    Euler parameters), so that it means the same anywhere along a line (a tolerance relative to
-    ``|u|`` would be 100 times looser 100 m down the line than at its start); the scaled
-    multipliers ``beta h^2 lambda`` count as the position change ``beta h^2 lambda / m`` they
-    cause on a mass ``m`` (the mean diagonal of ``M``), and ``nu`` as a position change.
-    Returns ``(y, a, v, v_dot)`` or None."""
-    n_u, n_c = st.n_u, st.n_c
-    y = st.start(y0, p, tol).copy()
-    bh2 = float(p[3 * n_u + 1])
-    fresh = refreshed
-    if not st.bulk.valid_for(bh2) or st.mass_scale is None:
-        st.factorize(y, p)
-        fresh = True
-    elif not refreshed and not st.keeps_coupling(p):
-        st.prepare(y, p)
-    scale = np.full_like(y, tol)
-    scale[n_u : n_u + n_c] = tol * st.mass_scale
-    weights = scale**-2
-    # the contraction below which the iteration updates its matrix, at the second update and later
-    slow_contraction = ((0.0, DIRECT_FIRST_CONTRACTION, DIRECT_SLOW_CONTRACTION) if st.direct else
-                        (0.0, SLOW_CONTRACTION, SLOW_CONTRACTION))
-    previous = None
-    step = None  # the last update, made with the current iteration matrix (see StepEquations.secant)
-    slow = 0
-    st.last_iterations = max_iterations + 1  # unless it converges
-    for iteration in range(max_iterations):
-        r = st.residual(y, p)
-        dy = st.solve(-r)
-        if step is not None:
-            dy = st.secant(dy, step, weights)
-        step = dy
-        y += dy
-        stats["newton_iterations"] += 1
-        err = np.abs(dy / scale).max(initial=0.0)
-        theta = err / previous if previous else 0.0
-        if not np.isfinite(err):
-            return None
-        if err <= 1.0 and theta < 1.0 and theta / (1.0 - theta) * err <= 1.0 or err <= 1e-3:
-            st.last_iterations = iteration + 1
-            a, v, v_dot = st.update(y, p)
-            if st.variant == "stabilized":
-                st.history.converged(a, y[n_u + n_c : n_u + 2 * n_c], st.last_shift, p, n_u, st.mode)
-            return y, a, v, v_dot
-        if previous is not None and theta > slow_contraction[min(iteration, 2)]:
-            if fresh and theta >= 1.0:
-                return None  # diverging with an up-to-date matrix
-            slow += 1
-            if slow == 1:  # the contact moved on: the rest at the current iterate first
-                st.prepare(y, p)
-            else:
-                st.factorize(y, p)
-                fresh = True
-            previous = step = None
-            continue
-        previous = err
-    if not fresh:  # a last attempt with an up-to-date matrix from the predictor
-        st.factorize(y0, p)
-        return solve_step(st, y0, p, tol, max_iterations, stats, refreshed=True)
-    return None
-

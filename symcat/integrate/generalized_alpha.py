@@ -256,7 +256,7 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
     tol : float
         Newton tolerance on the coordinates (absolute: m, or the dimensionless slopes and Euler
         parameters; multipliers counted as the position change they cause, see
-        :func:`~.alpha_step.solve_step`). The iteration stops on the same side
+        :func:`~.alpha_newton.solve_step`). The iteration stops on the same side
         every step, so its error adds up over the steps: keep ``tol`` well below the step's local
         error (on the double pendulum at dt = 1 ms, 1e-8 tripled the error at 2 s; 1e-10 left it).
     max_iterations : int
