@@ -110,14 +110,28 @@ class Bulk:
         ``p`` and stabilization shift ``shift_b``.
 
         With ``a = (y_b - u_pred - shift_b) / (beta h^2)`` and ``v = v_pred + gamma h a``, the
-        residual ``beta h^2 (M (c_m a + b) + D v - f)`` is ``B (y_b - shift_b) + c - beta h^2
-        f_n``: ``B = c_m M + gamma h D`` (plus ``beta h^2 K`` of linearized wires), ``c`` the
+        residual is ``beta h^2 (M (c_m a + b) + D v - f)``. Linearized wires: ``B (y_b -
+        shift_b) + c - beta h^2 f_n`` with ``B = c_m M + gamma h D + beta h^2 K``, ``c`` the
         rest of the affine part, both fixed over a step, and ``f_n`` the forces that are not
-        affine. One sparse product per Newton iteration instead of three."""
+        affine: one sparse product per Newton iteration instead of three. Nonlinear wires: the
+        mass and Rayleigh products as written (``B`` would have the Rayleigh matrix's denser
+        pattern, and its two products per step cost more than these per iteration)."""
         if self._whole is not None:
             return self._whole.nonzeros(y_b, p, 0.0 if shift_b is None else shift_b)[0]
         n_b, n_u = self.n_b, self.n_u
         u_pred, v_pred, b, t, bh2, gh, cm = step_data(p, n_u)
+        if self._forces.stiffness is None:
+            e = y_b - u_pred[:n_b]
+            if shift_b is not None:
+                e -= shift_b
+            r = self._mass_csr @ (cm * e + bh2 * b[:n_b])
+            v_b = v_pred[:n_b] + (gh / bh2) * e
+            if self.rayleigh.nnz:
+                r += self._rayleigh_csr @ (bh2 * v_b)
+            f = self._forces(y_b, v_b, t)
+            if f is not None:
+                r -= bh2 * f
+            return r
         matrix, c = self._affine(p)
         a = (y_b - u_pred[:n_b] - shift_b) / bh2
         r = matrix @ y_b + c
@@ -270,7 +284,7 @@ class _BulkForces:
             fn = ca.Function(f"alpha_bulk_{lib}", [q_g, v_g, t], [ca.densify(ca.vec(out))])
             flat = rows.ravel()
             self._groups.append((BufferedFunction(_expanded(fn, expand)), flat))
-        if self._picked is not None and self._groups:
+        if self._picked is not None:
             # a group's coordinates straight from y_b (free ones) and q_fixed: no vector of all
             y_of_q = np.full(self._n_q, -1)
             y_of_q[self._picked] = np.arange(n_b)
@@ -280,6 +294,14 @@ class _BulkForces:
                 free = at >= 0
                 fixed = self._q_fixed[flat] * ~free
                 self._gathers.append((fn, np.where(free, at, 0), free, fixed, at[free]))
+            # The picked coordinates are a few contiguous runs (a line's anchors and supports
+            # are the gaps): copied as slices into kept buffers that hold the fixed values,
+            # three times faster than indexing by the picks.
+            breaks = np.flatnonzero(np.diff(self._picked) != 1) + 1
+            starts, stops = np.r_[0, breaks], np.r_[breaks, n_b]
+            self._runs = [(int(self._picked[a]), int(self._picked[a]) + int(b - a), int(a), int(b))
+                          for a, b in zip(starts, stops)]
+            self._q_buffer, self._v_buffer = self._q_fixed.copy(), np.zeros(self._n_q)
 
     def __call__(self, y_b: np.ndarray, v_b: np.ndarray, t: float) -> np.ndarray | None:
         """The forces at ``(y_b, v_b, t)`` but the linearized wires' affine ones (None: no
@@ -294,19 +316,32 @@ class _BulkForces:
                     values = fn.nonzeros(fixed + np.where(free, y_b[at], 0.0), np.where(free, v_b[at], 0.0), t)[0]
                     f += np.bincount(to, values[free], minlength=y_b.size)
                 return f
-        if picked is None:
-            q, v = self._q_fixed + self._to_q @ y_b, self._to_q @ v_b
-        else:
-            q, v = self._q_fixed.copy(), np.zeros(self._n_q)
-            q[picked] += y_b
-            v[picked] = v_b
+        if picked is not None:
+            return self._picked_forces(y_b, v_b, t)
+        q, v = self._q_fixed + self._to_q @ y_b, self._to_q @ v_b
         f = np.zeros(self._n_q)
         if self.stiffness is None:
             # (dense outputs: their nonzeros are the vector, no scatter into a new array)
             f[: self._n_a] = self._ancf.nonzeros(q[: self._n_a], v[: self._n_a])[0]
         for fn, flat in self._groups:
             f += np.bincount(flat, fn.nonzeros(q[flat], v[flat], t)[0], minlength=self._n_q)
-        return self._to_free @ f if picked is None else f[picked]
+        return self._to_free @ f
+
+    def _picked_forces(self, y_b: np.ndarray, v_b: np.ndarray, t: float) -> np.ndarray:
+        """:meth:`__call__` of nonlinear wires whose free coordinates are picked (no Cholesky
+        coordinates): the wires' forces on the buffers and on the free coordinates by runs,
+        each group's added by its free entries."""
+        q, v, q_fixed = self._q_buffer, self._v_buffer, self._q_fixed
+        for qa, qb, ya, yb in self._runs:
+            np.add(q_fixed[qa:qb], y_b[ya:yb], out=q[qa:qb])
+            v[qa:qb] = v_b[ya:yb]
+        f_wires = self._ancf.nonzeros(q[: self._n_a], v[: self._n_a])[0]
+        f = np.empty(y_b.size)
+        for qa, qb, ya, yb in self._runs:
+            f[ya:yb] = f_wires[qa:qb]
+        for (fn, flat), (_, _, free, _, to) in zip(self._groups, self._gathers):
+            f += np.bincount(to, fn.nonzeros(q[flat], v[flat], t)[0][free], minlength=y_b.size)
+        return f
 
 
 def _expanded(fn: ca.Function, expand: bool) -> ca.Function:

@@ -65,7 +65,7 @@ DIRECT_KEPT_ITERATIONS = 5
 #: a factor 10 of its column's largest entry.
 DIRECT_LU = {"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.1}
 
-_GETRS = sla.get_lapack_funcs("getrs", dtype=np.float64)
+_GETRF, _GETRS = sla.get_lapack_funcs(("getrf", "getrs"), dtype=np.float64)
 _SINGULAR = ("generalized-alpha: singular iteration matrix (redundant constraints, or a sliding joint at a point "
              "where its wire has no tangent?)")
 
@@ -160,6 +160,7 @@ class StepEquations:
                 Terms(np.arange(k), self.rest_columns, np.ones(k), np.zeros(k)),
                 Terms(np.arange(n_p), self.p_columns, np.ones(n_p), np.zeros(n_p)), np.zeros(0),
                 *output_maps(identity, self._r_rows, self._shift_rows, self._jac_rows, self._jac_cols), n_y, n_u)
+        self._contact_data = None  # the step data of contacts()
         self.mass_scale = mass_scale  # kg: mean diagonal of M, converts multiplier updates to positions
         self._coupling = None
         # (beta h^2, open flags) of a sparse capacitance that later steps may keep (see
@@ -262,7 +263,10 @@ class StepEquations:
         y[:n_u] = u
         if self.n_sc:
             y[self.n_y - self.n_sc :] = sc
-        p = np.r_[u, v, np.zeros(n_u), t, 1.0, 1.0, 1.0]
+        p = self._contact_data
+        if p is None:  # kept: a line's p is tens of thousands of entries, built at every step
+            p = self._contact_data = np.r_[np.zeros(3 * n_u), 0.0, 1.0, 1.0, 1.0]
+        p[:n_u], p[n_u : 2 * n_u], p[3 * n_u] = u, v, t
         _, _, gap, force = self._rest.nonzeros(*self._placement(y).inputs(y, p), self.mode)
         return gap, force
 
@@ -398,12 +402,12 @@ class StepEquations:
         z_k = np.eye(k)
         if n_t:
             z_k[:n_t, :n_t] = z_bulk[touched]
-        try:
-            cap = sla.lu_factor(np.eye(k) + delta @ z_k, check_finite=False)
-        except (ValueError, sla.LinAlgError):
-            raise SolverError(_SINGULAR) from None
-        if np.any(np.diag(cap[0]) == 0):
-            raise SolverError(_SINGULAR)
+        cap = None  # (nothing touched: solve() needs no capacitance)
+        if k:  # LAPACK directly, as in solve(): lu_factor's checks cost as much as this small factorization
+            lu, piv, info = _GETRF(np.eye(k) + delta @ z_k, overwrite_a=1)
+            if info != 0:  # > 0: an exactly zero pivot (< 0, a wrong argument, cannot happen here)
+                raise SolverError(_SINGULAR)
+            cap = (lu, piv)
         self._coupling = (keys, n_t, delta, z_bulk, cap)
         self._prepared = None
 
