@@ -138,10 +138,10 @@ class _StepSystem:
         n_u = n_f + n_s
         bh2 = h * h
         y, p = self._step_point(u, bh2)
-        self.step.factorize(y, p)
+        self.step.linear.factorize(y, p)
         # rows: -h^2 on the force rows, 1 on C and T; the step's order [forces, C, T]
         r = np.concatenate([-bh2 * rhs[:n_u], rhs[n_u : n_u + n_c], rhs[n_u + n_c :]])
-        dy = self.step.solve(r)
+        dy = self.step.linear.solve(r)
         return np.concatenate([dy[:n_u], dy[n_u + n_c :], dy[n_u : n_u + n_c] / bh2])
 
     def stiffness_diagonal(self, u: np.ndarray) -> np.ndarray:

@@ -41,10 +41,10 @@ def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: 
     bh2 = float(p[3 * n_u + 1])
     fresh = refreshed
     if not st.bulk.valid_for(bh2) or st.mass_scale is None:
-        st.factorize(y, p)
+        st.linear.factorize(y, p)
         fresh = True
-    elif not refreshed and not st.keeps_coupling(p):
-        st.prepare(y, p)
+    elif not refreshed and not st.linear.keeps_coupling(p):
+        st.linear.prepare(y, p)
     scale = np.full_like(y, tol)
     scale[n_u : n_u + n_c] = tol * st.mass_scale
     weights = scale**-2
@@ -52,14 +52,14 @@ def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: 
     slow_contraction = ((0.0, DIRECT_FIRST_CONTRACTION, DIRECT_SLOW_CONTRACTION) if st.direct else
                         (0.0, SLOW_CONTRACTION, SLOW_CONTRACTION))
     previous = None
-    step = None  # the last update, made with the current iteration matrix (see StepEquations.secant)
+    step = None  # the last update, made with the current iteration matrix (see StepSolve.secant)
     slow = 0
     st.last_iterations = max_iterations + 1  # unless it converges
     for iteration in range(max_iterations):
         r = st.residual(y, p)
-        dy = st.solve(-r)
+        dy = st.linear.solve(-r)
         if step is not None:
-            dy = st.secant(dy, step, weights)
+            dy = st.linear.secant(dy, step, weights)
         step = dy
         y += dy
         stats["newton_iterations"] += 1
@@ -78,15 +78,15 @@ def solve_step(st: StepEquations, y0, p, tol, max_iterations, stats, refreshed: 
                 return None  # diverging with an up-to-date matrix
             slow += 1
             if slow == 1:  # the contact moved on: the rest at the current iterate first
-                st.prepare(y, p)
+                st.linear.prepare(y, p)
             else:
-                st.factorize(y, p)
+                st.linear.factorize(y, p)
                 fresh = True
             previous = step = None
             continue
         previous = err
     if not fresh:  # a last attempt with an up-to-date matrix from the predictor
-        st.factorize(y0, p)
+        st.linear.factorize(y0, p)
         return solve_step(st, y0, p, tol, max_iterations, stats, refreshed=True)
     return None
 

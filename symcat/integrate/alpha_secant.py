@@ -1,10 +1,10 @@
 """Broyden's secant updates of a kept generalized-alpha step matrix
-(:meth:`.alpha_step.StepEquations.secant`)."""
+(:meth:`.alpha_linear.StepSolve.secant`)."""
 from __future__ import annotations
 
 import numpy as np
 
-#: Broyden updates of a kept step matrix at most (:meth:`.alpha_step.StepEquations.secant`).
+#: Broyden updates of a kept step matrix at most (:meth:`.alpha_linear.StepSolve.secant`).
 MAX_SECANTS = 20
 #: A secant update that would scale the Newton update by more than this is skipped.
 SECANT_GAIN = 10.0
@@ -12,7 +12,7 @@ SECANT_GAIN = 10.0
 
 class Secants:
     """Broyden's updates of an inverse matrix ``H_0`` in product form, ``H = (I + s_k c_k^T)
-    ... (I + s_1 c_1^T) H_0`` (:meth:`.alpha_step.StepEquations.secant`), applied at once: with ``z_0 = H_0
+    ... (I + s_1 c_1^T) H_0`` (:meth:`.alpha_linear.StepSolve.secant`), applied at once: with ``z_0 = H_0
     v``, ``H v = z_0 + S^T alpha`` where ``alpha`` solves the unit lower triangular ``alpha_j -
     sum_{i<j} (c_j^T s_i) alpha_i = c_j^T z_0``, whose inverse is kept (a few products with
     small matrices instead of ``k`` pairs of vector operations)."""

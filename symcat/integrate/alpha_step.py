@@ -1,5 +1,5 @@
-"""The equations of one generalized-alpha step and their linear solve (the modified Newton
-iteration over them: :mod:`.alpha_newton`), for
+"""The equations of one generalized-alpha step (their linear solve: :mod:`.alpha_linear`; the
+modified Newton iteration over them: :mod:`.alpha_newton`), for
 :mod:`symcat.integrate.generalized_alpha` (whose module docstring explains the method, the
 unknowns and the scaling).
 
@@ -22,9 +22,10 @@ ANCF coordinates of the elements a contact can currently touch (its element wind
 When the wires are not the larger part of the unknowns (the seed paper's 8-element wire under
 its vehicle, or no wire at all) the whole step matrix is factorized instead (sparse LU), and a
 rest of many unknowns keeps its factorization over the steps while Newton converges fast
-(:meth:`StepEquations.keeps_coupling`), improved in between by Broyden's secant updates
-(:meth:`StepEquations.secant`). Under the stabilized form the iteration starts from the
-multipliers ``nu`` extrapolated from the last steps (:class:`.alpha_history.StartHistory`).
+(:meth:`.alpha_linear.StepSolve.keeps_coupling`), improved in between by Broyden's secant
+updates (:meth:`.alpha_linear.StepSolve.secant`); the linear solve is
+:mod:`.alpha_linear`'s. Under the stabilized form the iteration starts from the multipliers
+``nu`` extrapolated from the last steps (:class:`.alpha_history.StartHistory`).
 
 This is how dedicated pantograph/catenary codes keep a constant iteration matrix while the
 contact point moves; refactorizing a 7,000-unknown line whenever the contact crosses an element,
@@ -34,46 +35,24 @@ from __future__ import annotations
 
 import casadi as ca
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sps
-import scipy.sparse.linalg as spla
 
 from ..assembly.wheelrail import has_creep
 from ..codegen.library import BufferedFunction, symbolic_kernels
 from ..dae.formulation import Formulation
-from ..errors import SolverError
 from .alpha_bulk import Bulk, step_data
 from .alpha_history import StartHistory
+from .alpha_linear import StepSolve
 from .alpha_placement import Placement, Terms, csc_pattern, identity, output_maps, weighted_sum
 from .alpha_proxies import Proxies
 from .alpha_rest import compiled_rest, expanded_rest
-from .alpha_secant import Secants
-
-#: Unknowns of the rest above which its capacitance is factorized sparse (a vehicle's bodies,
-#: joints and contacts: hundreds of unknowns, a few nonzeros per row) instead of dense.
-DENSE_CAPACITANCE = 200
-#: A kept coupling (:meth:`StepEquations.keeps_coupling`) is prepared afresh after a step that
-#: took more Newton iterations than this.
-KEPT_ITERATIONS = 4
-#: With the step matrix factorized whole (:attr:`StepEquations.direct`) and kept over steps, a
-#: step after one of more than this many iterations starts from an updated matrix (see
-#: :data:`.alpha_newton.DIRECT_SLOW_CONTRACTION`).
-DIRECT_KEPT_ITERATIONS = 5
-#: SuperLU's options for the step matrix factorized whole: a symmetric ordering (the pattern is
-#: structurally symmetric but for the constraints' rows: less fill than the default column
-#: ordering, so faster solves) and threshold partial pivoting that keeps a diagonal pivot within
-#: a factor 10 of its column's largest entry.
-DIRECT_LU = {"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.1}
-
-_GETRF, _GETRS = sla.get_lapack_funcs(("getrf", "getrs"), dtype=np.float64)
-_SINGULAR = ("generalized-alpha: singular iteration matrix (redundant constraints, or a sliding joint at a point "
-             "where its wire has no tangent?)")
 
 
 class StepEquations:
     """The step equations of one element window: the rest's residual and exact Jacobian (one
     expanded function), with the window-independent :class:`Bulk` (carried over from the
-    previous window's equations) and the split linear solve of the modified Newton iteration.
+    previous window's equations) and the split linear solve of the modified Newton iteration
+    (:attr:`linear`, a :class:`~.alpha_linear.StepSolve`).
 
     ``y = [u, beta h^2 lambda (, nu), s_c]`` and the rows ``[dynamics, C_s^T lambda, C (, velocity
     constraints), T]``: the arc lengths ``s_c`` of the penalty contacts are algebraic unknowns of
@@ -162,14 +141,10 @@ class StepEquations:
                 *output_maps(identity, self._r_rows, self._shift_rows, self._jac_rows, self._jac_cols), n_y, n_u)
         self._contact_data = None  # the step data of contacts()
         self.mass_scale = mass_scale  # kg: mean diagonal of M, converts multiplier updates to positions
-        self._coupling = None
-        # (beta h^2, open flags) of a sparse capacitance that later steps may keep (see
-        # :meth:`keeps_coupling`), else None.
-        self._prepared = None
         self.last_iterations = 0
         self.history = StartHistory()
         self.last_shift = None  # the shift G^T nu of the last update()
-        self._secants = Secants(n_y if self.direct else 0)  # Broyden updates of a direct factorization, see secant()
+        self.linear = StepSolve(self)  # the iteration matrix and its solves
 
     def reset(self) -> None:
         """Forget the factorizations, the prepared coupling and the open flags (a new run on
@@ -178,8 +153,8 @@ class StepEquations:
         self.bulk._columns.clear()
         self.bulk._last = None
         self.mode[:] = 0.0
-        self._coupling, self._prepared, self.last_iterations = None, None, 0
-        self._secants.clear()
+        self.last_iterations = 0
+        self.linear.clear()
         self.history.clear()
 
     def _rows(self, y, p, mode, contacts: bool = False, part: str = "rest"):
@@ -345,7 +320,7 @@ class StepEquations:
         jac.eliminate_zeros()  # the pattern's structural zeros (open contacts...) would cost the sparse LU
         return jac
 
-    # --- the linear solve ---------------------------------------------------------------------
+    # --- scaling and start of the iteration ----------------------------------------------------
     def scale_multipliers(self, y) -> float:
         """:attr:`mass_scale`, set at ``y`` if not yet: the mean of the mass matrix's own
         diagonal (the iteration matrix's also holds beta h^2 K, which on the stiff
@@ -354,62 +329,6 @@ class StepEquations:
             diag = np.abs(self.mass(y).diagonal())
             self.mass_scale = float(diag.mean()) if diag.size and diag.mean() > 0 else 1.0
         return self.mass_scale
-
-    def factorize(self, y, p) -> None:
-        """Refactorize the bulk matrix at ``(y, p)`` and prepare the rest's coupling there."""
-        self.scale_multipliers(y)
-        if self.direct:  # prepare factorizes everything
-            self.bulk.lu, self.bulk.bh2 = True, float(p[3 * self.n_u + 1])
-        else:
-            self.bulk.set(y, p, self._rest_values(y, p)[1])
-        self.prepare(y, p)
-
-    def prepare(self, y, p) -> None:
-        """The Woodbury update of the rest's exact Jacobian at ``(y, p)``: the unknowns ``K`` it
-        touches (every non-bulk unknown and the bulk ones in a nonzero row or column), the
-        columns ``Z = P^-1 E_K`` (``P`` = bulk matrix, identity elsewhere), and the factorized
-        capacitance ``I + Delta Z_K`` with ``Delta = J_rest[K, K] - I`` on the non-bulk part."""
-        if self.direct:
-            self._secants.clear()
-            try:
-                self._coupling = spla.splu(self.jacobian(y, p), **DIRECT_LU)
-            except RuntimeError:
-                raise SolverError(_SINGULAR) from None
-            self.bulk.factorizations += 1
-            self._prepared = (float(p[3 * self.n_u + 1]), self.mode.copy())
-            return
-        n_b, n_y = self.bulk.n_b, self.n_y
-        placement, data = self._rest_triplets(y, p)
-        keys, flat, k = placement.touched(n_b)
-        n_t = k - (n_y - n_b)
-        touched = keys[:n_t]
-        z_bulk = self.bulk.columns(touched) if n_t else np.zeros((n_b, 0))
-        if k > DENSE_CAPACITANCE:
-            # Bodies with many coordinates (a vehicle on a line): the capacitance is the rest's
-            # sparse Jacobian but for the block of the touched wire unknowns.
-            delta = sps.csr_matrix((data, (flat // k, flat % k)), shape=(k, k))
-            delta = (delta - sps.diags(np.r_[np.zeros(n_t), np.ones(k - n_t)])).tocsr()
-            z_k = sps.block_diag([sps.csr_matrix(z_bulk[touched]), sps.identity(k - n_t)], format="csr")
-            try:
-                cap = spla.splu((sps.identity(k) + delta @ z_k).tocsc())
-            except RuntimeError:
-                raise SolverError(_SINGULAR) from None
-            self._coupling = (keys, n_t, delta, z_bulk, cap)
-            self._prepared = (float(p[3 * self.n_u + 1]), self.mode.copy())
-            return
-        delta = weighted_sum(flat, data, k * k).reshape(k, k)
-        delta[n_t:, n_t:] -= np.eye(k - n_t)
-        z_k = np.eye(k)
-        if n_t:
-            z_k[:n_t, :n_t] = z_bulk[touched]
-        cap = None  # (nothing touched: solve() needs no capacitance)
-        if k:  # LAPACK directly, as in solve(): lu_factor's checks cost as much as this small factorization
-            lu, piv, info = _GETRF(np.eye(k) + delta @ z_k, overwrite_a=1)
-            if info != 0:  # > 0: an exactly zero pivot (< 0, a wrong argument, cannot happen here)
-                raise SolverError(_SINGULAR)
-            cap = (lu, piv)
-        self._coupling = (keys, n_t, delta, z_bulk, cap)
-        self._prepared = None
 
     def start(self, y0, p, tol: float) -> np.ndarray:
         """The Newton iteration's start from the integrator's predictor ``y0``: under the
@@ -425,50 +344,3 @@ class StepEquations:
         y = y0.copy()
         y[n_u + n_c : n_u + 2 * n_c], y[:n_u] = found[0], y[:n_u] + found[1]
         return y
-
-    def secant(self, z: np.ndarray, step: np.ndarray, weights: np.ndarray) -> np.ndarray:
-        """The Newton update ``z = -H F(y)`` (``H`` the inverse iteration matrix, :meth:`solve`)
-        after the update ``step`` made with the same ``H``, corrected by Broyden's secant update
-        of ``H`` (:meth:`.alpha_secant.Secants.update`), kept for the later iterations and steps
-        until the next factorization.
-
-        With the step matrix factorized whole and kept over steps (:attr:`direct`), what the
-        kept matrix misses is mostly a few directions (on the seed's complete scene, the
-        torsion of the wire's cross-sections near the contact, whose small stiffness turns a
-        slight drift of their coupling terms into an overshooting update). A secant update
-        learns them from the iterations themselves: fewer slow iterations and refactorizations."""
-        return self._secants.update(z, step, weights) if self.direct else z
-
-    def keeps_coupling(self, p) -> bool:
-        """Whether the next step may keep the rest's coupling prepared at an earlier step: a
-        rest of many unknowns (:data:`DENSE_CAPACITANCE`, or a step matrix factorized whole: a
-        vehicle's bodies and contacts, whose Jacobian and sparse factorization cost several
-        residuals and change little from step to step), the same step size and open contacts, and a last step that converged in
-        at most :data:`KEPT_ITERATIONS` iterations (:data:`DIRECT_KEPT_ITERATIONS` for a step
-        matrix factorized whole). A rest of a few pantograph unknowns on a
-        line is prepared every step: its contact crosses elements, and a kept coupling cost
-        more iterations than it saved."""
-        most = DIRECT_KEPT_ITERATIONS if self.direct else KEPT_ITERATIONS
-        if self._prepared is None or self.last_iterations > most:
-            return False
-        bh2, mode = self._prepared
-        return bh2 == float(p[3 * self.n_u + 1]) and np.array_equal(mode, self.mode)
-
-    def solve(self, rhs: np.ndarray) -> np.ndarray:
-        """``J^-1 rhs`` with ``J = P + E_K Delta E_K^T`` (Woodbury), or by the factorized ``J``
-        and its secant updates (:meth:`secant`)."""
-        if self.direct:
-            return self._secants.apply(self._coupling.solve(rhs))
-        keys, n_t, delta, z_bulk, cap = self._coupling
-        n_b = self.bulk.n_b
-        x = rhs.copy()
-        x[:n_b] = self.bulk.solve(rhs[:n_b])
-        if not keys.size:  # wires only
-            return x
-        if isinstance(cap, spla.SuperLU):
-            w = cap.solve(delta @ x[keys])
-        else:  # LAPACK directly: lu_solve's checks cost as much as this small solve
-            w = _GETRS(*cap, delta @ x[keys])[0]
-        x[:n_b] -= z_bulk @ w[:n_t]
-        x[n_b:] -= w[n_t:]
-        return x

@@ -64,10 +64,10 @@ def test_split_jacobian_and_woodbury_solve(line, variant):
     # nu (stabilized) enters the bulk rows through the shift of a: the Jacobian carries its
     # linear part with the Rayleigh matrix, exact here (no element damping)
     assert np.abs((jac - fd) / scale).max() < 1e-5
-    st.factorize(y, p)
+    st.linear.factorize(y, p)
     rhs = rng.normal(size=st.n_y)
     exact = spla.spsolve(st.jacobian(y, p).tocsc(), rhs)
-    assert np.abs(st.solve(rhs) - exact).max() < 1e-8 * np.abs(exact).max()
+    assert np.abs(st.linear.solve(rhs) - exact).max() < 1e-8 * np.abs(exact).max()
 
 
 def test_proxy_element_equals_the_window(line):
@@ -248,3 +248,18 @@ def test_start_history_extrapolates_only_a_continued_chain():
     assert len(hist.a) == 2
     p = p_of(bh2 / 4)
     assert hist.predict(p[:n_u] + bh2 / 4 * (a[1] + (a[1] - a[0])), p, n_u, mode, tol) is None
+
+
+def test_a_singular_capacitance_is_reported(line, monkeypatch):
+    """A rest whose exact Jacobian is singular (here: zero, as a redundant constraint's rows
+    would leave it) stops the step with the solver's message, not with NaNs or LAPACK's."""
+    from symcat.errors import SolverError
+
+    form = Formulation(line, "augmented", "1")
+    st = StepEquations(form, "index3")
+    y, p = _point(st, line, np.random.default_rng(5))
+    st.linear.factorize(y, p)  # regular
+    triplets = st._rest_triplets
+    monkeypatch.setattr(st, "_rest_triplets", lambda y, p: (triplets(y, p)[0], np.zeros_like(triplets(y, p)[1])))
+    with pytest.raises(SolverError, match="singular iteration matrix"):
+        st.linear.prepare(y, p)
