@@ -61,7 +61,10 @@ NOTES = [
     "runs keep the integrator's own multipliers (no KKT solve per output), as Exudyn reports only its "
     "sensors; each model's compiled library is built before the timed runs, as the kernels are, in its "
     "optimized tier (-O2; 20 to 90 s once per model; a user's first run takes the -O0 library while the "
-    "optimized one compiles in the background).",
+    "optimized one compiles in the background). Every timed run builds its model anew and finds that "
+    "library from a digest of the model (`symcat.integrate.alpha_chunk_cache`), without building the "
+    "Python step equations, which only a step that falls back to Python (or the start filter when "
+    "rho_inf < 1, as on the pendulum) builds.",
     "- **IDAS on the moving load and the pendulum**: the error does not change with rtol (1e-5 to 2e-5 m): "
     "it is the distance between IDAS's solution and symcat's generalized-alpha reference, whose numerical "
     "dissipation (spectral radius 0.8 on the pendulum) and step leave that much; the IDAS points therefore "

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from ..codegen.fingerprint import scene_digest
 from ..codegen.library import kernel_library, library_interface
 from ..errors import ParameterError
 from ..scene.ancf import AncfBody
@@ -97,6 +98,7 @@ class MultibodyModel(ElementWindows):
 
     def __init__(self, scene: Scene, window: int = 16):
         self.scene = scene
+        self.scene_digest = scene_digest(scene)  # what the model was built from (compiled steps' cache key)
         self.ancf = System(scene)
         n_a = self.ancf.n
         self.rigid_offset = {b.name: n_a + 7 * k for k, b in enumerate(scene.rigid_bodies)}

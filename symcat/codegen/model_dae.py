@@ -105,6 +105,24 @@ def compiled_library(name: str, key: bytes, write_c: Callable[[Path], Path], mod
     return target
 
 
+def existing_library(name: str, key: bytes, mode: str | None = None,
+                     optimized_flags: tuple = OPTIMIZED_FLAGS) -> Path | None:
+    """What :func:`compiled_library` with these arguments would return if that needs no
+    compiler now (the library it picks is cached; the optimized tier's background compiler is
+    started as it would start it), else None."""
+    mode = optimize_mode() if mode is None else mode
+    plain = cached_library(name, key, FLAGS)
+    optimized = cached_library(name, key, optimized_flags)
+    if mode != "off" and optimized.exists():
+        return optimized
+    target = optimized if mode == "now" else plain
+    if not target.exists():
+        return None
+    if mode == "background" and source_path(optimized).exists():
+        start_background(optimized, optimized_flags)
+    return target
+
+
 @contextmanager
 def _compiling(target: Path):
     """Held while this process compiles ``target``: an exclusive lock on ``<target>.compiling``

@@ -15,10 +15,13 @@ C and compiled once per model (cached on disk like the models' DAEs,
   with the element holding the point;
 - the iteration matrix is the step's Jacobian (but for what a point adds to the wires' own
   block), factorized in the code as a band (the wires, ordered by reverse Cuthill-McKee) with a
-  dense border (bodies, arc lengths, multipliers: :class:`.bordered_band.BorderedBand`), kept
-  across steps; when the iteration contracts slower than
-  :data:`~.alpha_newton.SLOW_CONTRACTION` its border is renewed at the current iterate, then the
-  whole matrix, as :func:`~.alpha_newton.solve_step` prepares the rest, then refactorizes;
+  dense border (bodies, arc lengths, multipliers: :class:`.bordered_band.BorderedBand`; of
+  its couplings to the wires only the columns and rows that can hold entries), kept across
+  steps; when the iteration contracts slower than :data:`CONTRACTIONS` its border is renewed
+  at the current iterate, then the whole matrix, as :func:`~.alpha_newton.solve_step` prepares
+  the rest, then refactorizes (the thresholds are inputs of the code, not part of it);
+- a run of a model whose steps were compiled before finds them from the model
+  (:mod:`.alpha_chunk_cache`) and builds the Python step equations only if a step falls back;
 - a step that fails even with a fresh matrix (divergence, :data:`MAX_ITERATIONS`, a
   non-finite update) ends the call; that step is then taken by
   :meth:`.alpha_integrator.Integrator.advance` (its own matrices, halving) and the compiled
@@ -30,6 +33,7 @@ unknowns or a band factorization of more than :data:`MAX_BAND_WORK` operations (
 steps' Python overhead is small against its arithmetic) keep the Python steps."""
 from __future__ import annotations
 
+import hashlib
 import logging
 from pathlib import Path
 
@@ -39,6 +43,7 @@ import numpy as np
 from ..codegen.library import BufferedFunction, symbolic_kernels, write_functions_c
 from ..errors import CompilerError
 from .alpha_bulk import step_data
+from .alpha_chunk_cache import model_key, read_record, write_record
 from .alpha_chunk_residual import ChunkResidual
 from .alpha_integrator import Integrator, State
 from .alpha_newton import SLOW_CONTRACTION
@@ -57,6 +62,17 @@ MAX_STEPS = LENGTHS[-1]
 #: factorized afresh at most :data:`ROUNDS` - 1 times in a step).
 MAX_ITERATIONS = 18
 ROUNDS = 3
+#: The contraction per iteration above which a round of a compiled step counts as slow and the
+#: next round starts from a renewed iteration matrix (one per round; inputs of the code, not
+#: part of it): for a matrix that is a band alone (wires), :data:`~.alpha_newton.SLOW_CONTRACTION`
+#: as in the Python steps, whose renewal is a refactorization of the wires.
+CONTRACTIONS = (SLOW_CONTRACTION,) * ROUNDS
+#: The same for a matrix with a border (bodies, sliding joints, contacts), renewed first at its
+#: border and then whole: a point moving along a wire slows the iteration by what a renewal at
+#: the current iterate does not remove (the element under the point changes within the step,
+#: its curvature terms are left out), so renewing at a contraction that low costs more
+#: renewals than the iterations they save.
+BORDER_CONTRACTIONS = (0.7,) * ROUNDS
 #: Unknowns besides the wires' at most (the border's Schur complement is dense).
 MAX_BORDER = 60
 #: Operations of the wires' band factorization at most, ``n_b (b + 1)^2`` (straight-line code:
@@ -87,7 +103,12 @@ class CompiledSteps:
         self._factor = None  # the iteration matrix's factor the compiled steps carry
         self._renew = True  # factorize it at the next call's first step
         self._scale = None
-        self.disabled = unsupported(integ)
+        self._mass_scale = None  # the multipliers' tolerance scale of the compiled steps (kg)
+        # The model's record (:mod:`.alpha_chunk_cache`): its library is found without the
+        # Python step equations, which are then built only if a step falls back to them.
+        self._key = model_key(integ.model, integ.form, _settings(integ.variant, integ.coef))
+        self._record = read_record(self._key)
+        self.disabled = unsupported(integ, self._record is not None)
 
     def advance(self, s: State, t0: float, n: int) -> State:
         """The state ``n`` steps of :attr:`h` after ``s`` at ``t0``."""
@@ -106,6 +127,8 @@ class CompiledSteps:
                 if k == n or done or not renew:
                     continue  # all done, or a failure that a call with a fresh matrix may pass
             if k < n:  # no compiled steps here, or failed on a fresh matrix: one Python step
+                if self._mass_scale is not None and integ.stepper.mass_scale is None:
+                    integ.stepper.mass_scale = self._mass_scale  # the compiled steps' tolerance
                 s = integ.advance(s, t0 + k * h, h)
                 self._renew = True
                 k += 1
@@ -116,7 +139,9 @@ class CompiledSteps:
         """Whether the compiled steps can run (building or loading them at the first call)."""
         if self._fns is not None:
             return True
-        integ, st = self.integ, self.integ.stepper
+        if self._record is not None and self._load_recorded():
+            return True
+        st = self.integ.stepper
         st.scale_multipliers(s.u)  # the scale of the multipliers' tolerance
         try:
             graph = _graph(ChunkResidual(st))
@@ -126,7 +151,7 @@ class CompiledSteps:
                 self.disabled = (f"{layout.n_r} unknowns besides the wires' (at most {MAX_BORDER}), a band "
                                  f"factorization of {work} operations (at most {MAX_BAND_WORK})")
                 return False
-            self._fns = _compiled(st, self.integ.coef, graph, self.build)
+            self._fns, library_key = _compiled(st, self.integ.coef, graph, self.build)
             if self._fns is None:
                 self.disabled = "not compiled yet, and a short run (see generalized_alpha's compiled)"
                 return False
@@ -134,11 +159,34 @@ class CompiledSteps:
             log.warning("generalized-alpha steps could not be compiled (%s); stepping in Python", exc)
             self.disabled = str(exc)
             return False
-        self._factor = np.zeros(layout.size)
-        self._cuts = np.cumsum([0, st.n_u, st.n_u, st.n_u, st.n_u, st.n_c, st.n_sc, st.n_u, st.n_c, st.n_sc]).tolist()
-        self._scale = np.full(st.n_y, integ.tol)
-        self._scale[st.n_u : st.n_u + st.n_c] *= st.mass_scale
+        write_record(self._key, library_key, st.mass_scale)
+        self._prepare(st.mass_scale)
         return True
+
+    def _load_recorded(self) -> bool:
+        """Load the library of the model's record (without the Python step equations); False
+        if it is not cached (any more) in the tier this run wants."""
+        from ..codegen.model_dae import existing_library
+
+        path = existing_library("alpha_chunk", self._record["library"].encode(), optimized_flags=OPTIMIZED_FLAGS)
+        if path is None:
+            return False
+        self._fns = _Lengths(path)
+        st = self.integ.built_stepper
+        self._prepare(self._record["mass_scale"] if st is None or st.mass_scale is None else st.mass_scale)
+        return True
+
+    def _prepare(self, mass_scale: float) -> None:
+        """The factor's storage (its size the library's), the packed state's layout and the
+        Newton tolerance's scale."""
+        n_u, n_c, n_sc, n_y = step_sizes(self.integ.form, self.integ.variant)
+        self._factor = np.zeros(self._fns[LENGTHS[0]].function.nnz_in(4))
+        self._cuts = np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc]).tolist()
+        self._mass_scale = mass_scale
+        model = self.integ.model
+        border = n_y > np.count_nonzero(model.free < model.ancf.n)  # unknowns besides the wires'
+        self._scale = np.r_[np.full(n_y, self.integ.tol), BORDER_CONTRACTIONS if border else CONTRACTIONS]
+        self._scale[n_u : n_u + n_c] *= mass_scale
 
     def _call(self, s: State, t: float, n: int):
         """``(steps done, state after them, Newton iterations)`` of one compiled call of at most
@@ -147,7 +195,7 @@ class CompiledSteps:
         length = next(L for L in LENGTHS if L >= min(n, per))
         x, self._factor, its, factorizations = self._fns[length].nonzeros(
             self._pack(s), t + h * np.arange(length), h, min(n, per), self._factor, float(self._renew), self._scale)
-        self.integ.stepper.bulk.factorizations += int(factorizations[0])
+        self.integ.compiled_factorizations += int(factorizations[0])
         done = min(int(np.argmin(its > 0)) if its.min() <= 0 else length, n, per)
         self._renew = done < min(n, per)  # a failure: renew the matrix where the next call starts
         if done:
@@ -165,37 +213,52 @@ class CompiledSteps:
         return State(u, v, v_dot, a, lam, sc, (a_prev, lam_prev, sc_prev), float(x[cuts[-1]]))
 
 
-def unsupported(integ: Integrator) -> str | None:
+def step_sizes(form, variant: str) -> tuple[int, int, int, int]:
+    """``(n_u, n_c, n_sc, n_y)`` of the steps of ``form`` (as :class:`StepEquations` has them)."""
+    n_u = form.n_f + form.n_s
+    return n_u, form.n_c, form.n_sc, n_u + form.n_c * (2 if variant == "stabilized" else 1) + form.n_sc
+
+
+def _settings(variant: str, coef) -> tuple:
+    """The run's settings that shape the compiled code (with its module's constants)."""
+    return (LENGTHS, MAX_ITERATIONS, ROUNDS, SLOW_CONTRACTION, variant, coef.rho_inf)
+
+
+def unsupported(integ: Integrator, recorded: bool = False) -> str | None:
     """Why ``integ``'s steps cannot run compiled, or None: wheel/rail contacts (events), or
-    element windows that move without proxy elements."""
+    element windows that move without proxy elements (``recorded``: the model's steps were
+    compiled before, see :mod:`.alpha_chunk_cache`)."""
     if integ.model.wheelrail:
         return "wheel/rail contacts"
+    if recorded:
+        return None
     if integ.model.windows_move() and integ.stepper.proxies is None:
         return ("element windows that move, without proxy elements (see symcat.integrate.alpha_proxies: "
                 "the code would hold every element under a point)")
     return None
 
 
-def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> dict | None:
+def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> tuple[dict | None, str]:
     """The compiled functions of :func:`_chunk_functions` by length, from the cache or
-    (``build``) generated now; None if not cached and not ``build``."""
+    (``build``) generated now (None if not cached and not ``build``), and the digest of the
+    library's key (which names it, for the model's record)."""
     from ..codegen.model_dae import compiled_library
 
-    settings = (LENGTHS, MAX_ITERATIONS, ROUNDS, SLOW_CONTRACTION, st.variant, coef.rho_inf)
     # The residual over the compiled kernels names the model; the rest of the code follows
     # from this module's source and the settings.
-    key = graph.serialize().encode() + repr(settings).encode() + b"|alpha_chunk|" + _SOURCE
+    key = graph.serialize().encode() + repr(_settings(st.variant, coef)).encode() + b"|alpha_chunk|" + _SOURCE
+    key = hashlib.sha256(key).hexdigest()
 
     def write(folder):
         with symbolic_kernels():
             fns = _chunk_functions(st, coef)
         return write_functions_c(fns, "alpha_chunk", folder)
 
-    path = compiled_library("alpha_chunk", key, write, build=build,  # -O0 first, optimized in the background
+    path = compiled_library("alpha_chunk", key.encode(), write, build=build,  # -O0 first, optimized in the background
                             optimized_flags=OPTIMIZED_FLAGS)
     if path is None:
-        return None
-    return _Lengths(path)
+        return None, key
+    return _Lengths(path), key
 
 
 class _Lengths(dict):
@@ -233,9 +296,9 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     rows, shift = residual.rows_and_shift(y, p)
     rows_of = ca.Function("alpha_chunk_rows", [y, p], [rows])
     shift_of = ca.Function("alpha_chunk_shift", [y, p], [shift]) if st.variant == "stabilized" and n_c else None
-    layout = _layout(st)
     y_b, y_r = ca.MX.sym("y_b", st.bulk.n_b), ca.MX.sym("y_r", n_y - st.bulk.n_b)
     jacobian = ca.Function("alpha_chunk_jacobian", [y_b, y_r, p], [residual.jacobian(y_b, y_r, p)])
+    layout = _layout(st, residual.couplings())
     jacobian_border = ca.Function("alpha_chunk_jacobian_border", [y_b, y_r, p],
                                   [residual.jacobian(y_b, y_r, p, wires=False)])
     jac = ca.project(jacobian(y[: st.bulk.n_b], y[st.bulk.n_b :], p), layout.pattern)
@@ -255,16 +318,17 @@ def _chunk_functions(st: StepEquations, coef) -> list:
 
     # One Newton iteration: (y, previous error, status, count, fresh) -> (y, error, status,
     # count); status 0 running, 1 converged, 2 failed, 3 slow (wants a fresh matrix): the
-    # tests of solve_step. fresh: the matrix was factorized in this step.
-    scale = ca.MX.sym("scale", n_y)
+    # tests of solve_step. fresh: the matrix was factorized in this step. scale: the Newton
+    # tolerance of each unknown, then the contraction above which the iteration is slow.
+    scale = ca.MX.sym("scale", n_y + 1)
     prev, status, count, fresh = ca.MX.sym("prev"), ca.MX.sym("status"), ca.MX.sym("count"), ca.MX.sym("fresh")
     dy = -solve(factor, rows_of(y, p))
-    err = ca.mmax(ca.fabs(dy / scale))
+    err = ca.mmax(ca.fabs(dy / scale[:n_y]))
     theta = ca.if_else(prev > 0, err / prev, 0)
     finite = err < np.inf
     converged = ca.logic_and(finite, ca.logic_or(
         ca.logic_and(ca.logic_and(err <= 1, theta < 1), theta / ca.fmax(1 - theta, 1e-300) * err <= 1), err <= 1e-3))
-    slow = ca.logic_and(prev > 0, theta > SLOW_CONTRACTION)
+    slow = ca.logic_and(prev > 0, theta > scale[n_y])
     diverging = ca.logic_and(fresh > 0, theta >= 1)  # on a fresh matrix: the step fails
     failed = ca.logic_or(ca.logic_or(ca.logic_not(finite), ca.logic_and(slow, diverging)),
                          count + 1 >= MAX_ITERATIONS)
@@ -277,6 +341,9 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     # One step: (packed state, factor, renew, t0, h, index, n, scale) -> (state, factor,
     # iterations, factorizations)
     xk, t0, h, index, n = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h"), ca.MX.sym("k"), ca.MX.sym("n")
+    # scale: the Newton tolerance of each unknown, then per round the contraction above which
+    # the iteration counts as slow
+    scale = ca.MX.sym("scale", n_y + ROUNDS)
     renew = ca.MX.sym("renew")
     parts = ca.vertsplit(xk, np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc, 1, 1]).tolist())
     u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev, h_prev, was_failed = parts
@@ -294,8 +361,9 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     fr, factorizations = wanted, wanted
     e, stat, cnt = ca.MX(0), ca.if_else(active, 0, 1), ca.MX(0)  # an inactive step: "converged" untouched
     for round_ in range(ROUNDS):
+        round_scale = ca.vertcat(scale[:n_y], scale[n_y + round_])
         for _ in range(MAX_ITERATIONS // ROUNDS):
-            y_k, e, stat, cnt = newton(stat != 0, y_k, e, stat, cnt, fr, p_k, scale, f_k)
+            y_k, e, stat, cnt = newton(stat != 0, y_k, e, stat, cnt, fr, p_k, round_scale, f_k)
         wanted = stat == 3
         if round_ == ROUNDS - 1:
             continue
@@ -332,9 +400,10 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     return functions
 
 
-def _layout(st: StepEquations) -> BorderedBand:
+def _layout(st: StepEquations, couplings: tuple | None = None) -> BorderedBand:
     """The iteration matrix's :class:`BorderedBand`: the wires' block in the bulk's pattern,
-    the rows and columns of the other unknowns dense."""
+    the rows and columns of the other unknowns dense; of their couplings to the wires only
+    ``couplings = (e_cols, f_rows)`` (:meth:`.ChunkResidual.couplings`; default: all)."""
     n_b, n = st.bulk.n_b, st.n_y
     rows, cols = [], []
     if n_b:
@@ -344,7 +413,7 @@ def _layout(st: StepEquations) -> BorderedBand:
     border = np.argwhere((np.arange(n)[:, None] >= n_b) | (np.arange(n)[None, :] >= n_b))
     rows += border[:, 0].tolist()
     cols += border[:, 1].tolist()
-    return BorderedBand(ca.Sparsity.triplet(n, n, rows, cols), n_b)
+    return BorderedBand(ca.Sparsity.triplet(n, n, rows, cols), n_b, *(couplings or (None, None)))
 
 
 def _nonzeros(m: ca.MX) -> ca.MX:

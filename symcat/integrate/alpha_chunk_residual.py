@@ -192,6 +192,18 @@ class ChunkResidual:
             rows = rows + ca.vertcat(self._bulk(y[:n_b], p, shift[:n_b]), ca.MX(self.n_y - n_b, 1))
         return rows, shift
 
+    def couplings(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(e_cols, f_rows)``: the rest's unknowns (positions after the wires') whose columns,
+        and its rows whose entries, in the iteration matrix can be nonzero on the wires' rows
+        and columns (:meth:`jacobian`): the structure of the rest's Jacobian on the proxy
+        element, which moving it back to the actual element keeps, and the velocity
+        multipliers whose shift moves the wires. Built with ``expand``."""
+        n_b, jac = self.n_b, self._rest_jacobian
+        rows, cols = (np.array(x, int) for x in jac.sparsity_out(0).get_triplet())
+        shifted = np.unique(np.array(jac.sparsity_out(2).get_triplet()[1], int))  # the nu whose G^T has wire rows
+        e_cols = np.union1d(cols[rows < n_b], np.array(self._nu, int)[shifted] - n_b if self._nu else [])
+        return e_cols.astype(int), np.unique(np.array(jac.sparsity_out(1).get_triplet()[0], int))
+
     def jacobian(self, y_b, y_r, p, wires: bool = True):
         """The iteration matrix at ``y = [y_b, y_r]`` (symbols: wires' coordinates and the
         rest's unknowns), see the module's notes; ``wires=False``: its wires' block zero (for

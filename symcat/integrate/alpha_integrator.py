@@ -70,7 +70,11 @@ def step_equations(form: Formulation, variant: str, expand: bool = False,
 
 class Integrator:
     """Steps of the generalized-alpha method on ``form`` (its :class:`StepEquations`, rebuilt when an
-    element window moves), halving a step whose Newton iteration fails."""
+    element window moves), halving a step whose Newton iteration fails.
+
+    The step equations (:attr:`stepper`) are built at their first use: a run whose steps all
+    run compiled from a cached library (:mod:`.alpha_chunk`) and that starts without them
+    (``rho_inf = 1``) never builds them."""
 
     def __init__(self, model, form, coef, variant, tol, max_iterations, max_halvings, expand, stats,
                  compiled: bool | None = True):
@@ -83,7 +87,30 @@ class Integrator:
         self._order = [sorted(blocks, key=lambda name: blocks[name].start) for blocks in (self.xb, self.zb)]
         self.open_rows = []  # the constraint rows an event handler released (lifted wheels)
         self.singular_fails_step = False  # a singular iteration matrix: a failed step, not the run's end
-        self.stepper = self._build()
+        self.compiled_factorizations = 0  # of the compiled steps' iteration matrix (.alpha_chunk)
+        self._stepper = None
+
+    @property
+    def stepper(self) -> StepEquations:
+        """The step equations, built at the first use."""
+        if self._stepper is None:
+            self._stepper = self._build()
+        return self._stepper
+
+    @stepper.setter
+    def stepper(self, value: StepEquations) -> None:
+        self._stepper = value
+
+    @property
+    def built_stepper(self) -> StepEquations | None:
+        """The step equations if built, else None (without building them)."""
+        return self._stepper
+
+    @property
+    def factorizations(self) -> int:
+        """Factorizations of the iteration matrices so far: the Python steps' and the compiled
+        ones'."""
+        return self.compiled_factorizations + (self._stepper.bulk.factorizations if self._stepper is not None else 0)
 
     def _build(self, previous: StepEquations | None = None) -> StepEquations:
         build = time.perf_counter()

@@ -36,11 +36,19 @@ class BorderedBand:
         Of the whole matrix (n x n).
     n_b : int
         Size of the banded block.
+    e_cols, f_rows : sequence of int, optional
+        The border's columns whose rows in ``E`` and the border's rows whose columns in ``F``
+        can be nonzero (positions in the border, default all): on a wire with a body on a
+        sliding joint the body's own coordinates touch the wire through no entry of ``E``,
+        and each border column or row left out saves a band solve at every renewal of the
+        border and a column of the products at every solve.
     """
 
-    def __init__(self, sparsity: ca.Sparsity, n_b: int):
+    def __init__(self, sparsity: ca.Sparsity, n_b: int, e_cols=None, f_rows=None):
         n = sparsity.size1()
         self.n, self.n_b, self.n_r = n, n_b, n - n_b
+        self.e_cols = np.arange(self.n_r) if e_cols is None else np.asarray(e_cols, int)
+        self.f_rows = np.arange(self.n_r) if f_rows is None else np.asarray(f_rows, int)
         self.pattern = sparsity
         colind, row = sparsity.get_ccs()
         rows = np.array(row, int)
@@ -70,8 +78,11 @@ class BorderedBand:
         d = (rows >= n_b) & (cols >= n_b)
         self.d_from[rows[d] - n_b, cols[d] - n_b] = np.flatnonzero(d)
         self.band_entries = n_b * w
-        # the factor: LU of the band, X = B^-1 E, F, S^-1
-        self.size = n_b * w + 2 * n_b * self.n_r + self.n_r**2
+        # the couplings that can be nonzero: E's columns e_cols, F's rows f_rows
+        self.e_from, self.f_from = self.e_from[:, self.e_cols], self.f_from[self.f_rows, :]
+        # the factor: LU of the band, X = B^-1 E (n_b x n_e), F (n_f x n_b), S^-1
+        self.n_e, self.n_f = self.e_cols.size, self.f_rows.size
+        self.size = n_b * w + n_b * (self.n_e + self.n_f) + self.n_r**2
 
     # --- graphs -----------------------------------------------------------------------------
     def factorize(self, nonzeros: ca.MX) -> ca.MX:
@@ -97,12 +108,14 @@ class BorderedBand:
                                  lambda index: values[index.ravel(order="F").tolist()])
 
     def _with_border(self, lu: ca.MX, gather) -> ca.MX:
-        n_b, n_r = self.n_b, self.n_r
-        e = ca.reshape(gather(self.e_from), n_b, n_r)
-        f = ca.reshape(gather(self.f_from), n_r, n_b)
+        n_b, n_r, n_e, n_f = self.n_b, self.n_r, self.n_e, self.n_f
+        e = ca.reshape(gather(self.e_from), n_b, n_e)
+        f = ca.reshape(gather(self.f_from), n_f, n_b)
         d = ca.reshape(gather(self.d_from), n_r, n_r)
-        x = _band_solve(n_b, self.bw).map(n_r)(lu, e) if n_b else ca.MX(0, n_r)
-        s = d - ca.mtimes(f, x)
+        x = _band_solve(n_b, self.bw).map(n_e)(lu, e) if n_b and n_e else ca.MX(n_b, n_e)
+        s = ca.MX(d)
+        if n_e and n_f:
+            s[self.f_rows.tolist(), self.e_cols.tolist()] = s[self.f_rows.tolist(), self.e_cols.tolist()] - ca.mtimes(f, x)
         s_inv = ca.solve(s, ca.MX.eye(n_r), "qr")
         return ca.vertcat(lu, ca.vec(x), ca.vec(f), ca.vec(s_inv))
 
@@ -113,12 +126,17 @@ class BorderedBand:
         perm = self.perm.tolist()
         z = _band_solve(n_b, self.bw)(lu, rhs[perm]) if n_b else ca.MX(0, 1)
         if n_r:
+            n_e, n_f = self.n_e, self.n_f
             at = n_b * w
-            x = ca.reshape(factor[at : at + n_b * n_r], n_b, n_r)
-            f = ca.reshape(factor[at + n_b * n_r : at + 2 * n_b * n_r], n_r, n_b)
-            s_inv = ca.reshape(factor[at + 2 * n_b * n_r :], n_r, n_r)
-            y_r = ca.mtimes(s_inv, rhs[n_b:] - ca.mtimes(f, z))
-            z = z - ca.mtimes(x, y_r)
+            x = ca.reshape(factor[at : at + n_b * n_e], n_b, n_e)
+            f = ca.reshape(factor[at + n_b * n_e : at + n_b * (n_e + n_f)], n_f, n_b)
+            s_inv = ca.reshape(factor[at + n_b * (n_e + n_f) :], n_r, n_r)
+            t = ca.MX(rhs[n_b:])
+            if n_f:
+                t[self.f_rows.tolist()] = t[self.f_rows.tolist()] - ca.mtimes(f, z)
+            y_r = ca.mtimes(s_inv, t)
+            if n_e:
+                z = z - ca.mtimes(x, y_r[self.e_cols.tolist()])
         else:
             y_r = ca.MX(0, 1)
         back = np.empty(n_b, int)

@@ -219,12 +219,12 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
                 check_interrupt(t_s[out], t_end)
     except SolverError as err:
         bar.close()
-        stats["factorizations"] = integ.stepper.bulk.factorizations
+        stats["factorizations"] = integ.factorizations
         if run.stopped(err, wall0, t_end):
             return run
         raise
     bar.close()
-    stats["factorizations"] = integ.stepper.bulk.factorizations
+    stats["factorizations"] = integ.factorizations
     stats["wall_s"] = time.perf_counter() - wall0
     return run
 

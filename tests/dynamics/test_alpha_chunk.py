@@ -66,6 +66,76 @@ def test_band_and_border_solve_as_numpy(seed):
     assert np.abs(np.array(solve(m.data, b)).ravel() - np.linalg.solve(a, b)).max() < 1e-12
 
 
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_border_coupled_to_the_band_in_part_solves_as_numpy(seed):
+    """Border columns without entries in the band's rows and rows without entries in its
+    columns (a body's coordinates beside a wire): left out of ``E`` and ``F``, the factor is
+    smaller and solves like a dense solve; leaving out a column that has entries does not."""
+    rng = np.random.default_rng(seed)
+    n_b, n_r = 24, 5
+    a = np.zeros((n_b + n_r,) * 2)
+    for i in range(n_b):
+        for j in range(max(0, i - 2), min(n_b, i + 3)):
+            a[i, j] = rng.normal()
+        a[i, i] += 8.0
+    e_cols, f_rows = np.array([0, 2, 3]), np.array([1, 2])
+    a[:n_b, n_b + e_cols] = rng.normal(size=(n_b, e_cols.size))
+    a[n_b + f_rows, :n_b] = rng.normal(size=(f_rows.size, n_b))
+    a[n_b:, n_b:] = rng.normal(size=(n_r, n_r)) + 5 * np.eye(n_r)
+    # the pattern holds the whole border (as the compiled steps' does), zeros included
+    pattern = np.ones_like(a, bool)
+    pattern[:n_b, :n_b] = a[:n_b, :n_b] != 0
+    rows, cols = np.nonzero(pattern.T)  # column-major: CasADi's nonzero order
+    sparsity = ca.Sparsity.triplet(*a.shape, cols.tolist(), rows.tolist())
+    values = a.T[pattern.T]
+    b = rng.normal(size=n_b + n_r)
+    full = BorderedBand(sparsity, n_b)
+    part = BorderedBand(sparsity, n_b, e_cols, f_rows)
+    assert part.size == full.size - n_b * (2 * n_r - e_cols.size - f_rows.size)
+    nz, rhs = ca.MX.sym("nz", values.size), ca.MX.sym("rhs", n_b + n_r)
+    for layout in (full, part):
+        solve = ca.Function("solve", [nz, rhs], [layout.solve(layout.factorize(nz), rhs)])
+        assert np.abs(np.array(solve(values, b)).ravel() - np.linalg.solve(a, b)).max() < 1e-12
+    wrong = BorderedBand(sparsity, n_b, e_cols[:-1], f_rows)
+    solve = ca.Function("solve", [nz, rhs], [wrong.solve(wrong.factorize(nz), rhs)])
+    assert np.abs(np.array(solve(values, b)).ravel() - np.linalg.solve(a, b)).max() > 1e-6
+
+
+def test_the_border_couplings_are_the_step_jacobians(record_property):
+    """The border columns and rows the compiled steps keep in ``E`` and ``F``
+    (:meth:`ChunkResidual.couplings`) hold every nonzero of the step's iteration matrix there
+    (evaluated at a state with the load on an element), and the ones left out are zero."""
+    from symcat.codegen.library import symbolic_kernels
+    from symcat.dae.formulation import Formulation
+    from symcat.integrate.alpha_chunk_residual import ChunkResidual
+    from symcat.integrate.alpha_step import StepEquations
+
+    model = moving_load()
+    model.center_windows()
+    form = Formulation(model, "augmented", "1")
+    st = StepEquations(form, "stabilized")
+    with symbolic_kernels():
+        residual = ChunkResidual(st, expand=True)
+        n_b, n_y, n_u = st.bulk.n_b, st.n_y, st.n_u
+        y_b, y_r, p = ca.MX.sym("y_b", n_b), ca.MX.sym("y_r", n_y - n_b), ca.MX.sym("p", 3 * n_u + 4)
+        jac = ca.Function("j", [y_b, y_r, p], [residual.jacobian(y_b, y_r, p)])
+    e_cols, f_rows = residual.couplings()
+    rng = np.random.default_rng(0)
+    y = np.zeros(n_y)
+    y[:n_u] = np.r_[model.q0[model.free], model.s0] + 1e-3 * rng.normal(size=n_u)
+    y[n_u:] = rng.normal(size=n_y - n_u)
+    y[form.n_f] = 3.4  # the load's arc length: inside element 3
+    data = np.r_[y[:n_u], np.zeros(2 * n_u), 0.01, 1e-6, 1e-3, 1.0]
+    m = np.array(jac(y[:n_b], y[n_b:], data))
+    record_property("couplings", [e_cols.tolist(), f_rows.tolist()])
+    e_out = np.setdiff1d(np.arange(n_y - n_b), e_cols)
+    f_out = np.setdiff1d(np.arange(n_y - n_b), f_rows)
+    assert np.all(m[:n_b, n_b + e_out] == 0) and np.all(m[n_b + f_out, :n_b] == 0)
+    assert np.all(np.abs(m[:n_b, n_b + e_cols]).max(axis=0) > 0)
+    assert np.all(np.abs(m[n_b + f_rows, :n_b]).max(axis=1) > 0)
+    assert e_out.size >= 2  # the driving's multipliers act on the body alone
+
+
 def test_compiled_steps_of_a_spinning_cable_match_the_python_steps(record_property):
     """Wires only: the compiled steps refactorize their band in the code when the iteration
     slows, as the Python steps do; the two runs agree to the Newton tolerance."""
@@ -108,7 +178,7 @@ def test_steps_the_compiled_code_cannot_take_are_taken_in_python():
     assert np.isfinite(compiled.q).all()
 
 
-def moving_load(n_elements=12, window=3, speed=40.0):
+def moving_load(n_elements=12, window=3, speed=40.0, force=100.0):
     """A 1 g body driven along a taut 12 m wire on a sliding joint, carrying 100 N down (the
     peer bench's problem 2, shorter): it crosses an element every 25 ms."""
     from symcat.scene import Driving, PointLoad, RigidBody, SlidingJoint
@@ -122,7 +192,7 @@ def moving_load(n_elements=12, window=3, speed=40.0):
     scene.add(RigidBody("load", 1e-3, (1e-6,) * 3, (0.5, 0.0, 0.0), held=("rotation",)))
     scene.add(SlidingJoint("slider", "wire", "load", s0=0.5, at=(0.5, 0.0, 0.0), reference_direction=(0, 0, 1)))
     scene.add(Driving("drive", "load", direction=(1.0, 0.0, 0.0), velocity=speed))
-    scene.add(PointLoad("force", "load", force=(0.0, -100.0, 0.0)))
+    scene.add(PointLoad("force", "load", force=(0.0, -force, 0.0)))
     return MultibodyModel(scene, window=window)
 
 

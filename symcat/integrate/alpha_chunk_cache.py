@@ -1,0 +1,99 @@
+"""The compiled steps' cache keyed by the model (:mod:`.alpha_chunk`): a run of a model whose
+steps were compiled before finds their library without building the step's equations.
+
+Why: the compiled library is identified by the graph of the step's residual
+(:func:`.alpha_chunk._compiled`), and that graph is built from the Python step equations
+(:class:`~.alpha_step.StepEquations`, a :class:`~.alpha_chunk_residual.ChunkResidual`, a
+serialization): on a small model (a wire under a moving load, a cable pendulum) that set-up
+costs as much as the compiled steps of a coarse run. What the graph follows from is the
+scene the model was built from (plain data), the assembled model's initial state and fixed
+coordinates, the run's settings, symcat's source, the shipped kernels and the tools'
+versions; their digest (:func:`model_key`) names a small record (:func:`read_record`) that a
+run with the graph writes: the digest of the graph's key (which names the library) and the
+multipliers' tolerance scale. A run that finds the record loads the library and builds the
+Python step equations only if a step falls back to them.
+
+A model the digest cannot describe exactly has no key, and its runs take the graph's path as
+before: a scene holding something other than numbers, strings, arrays, sparse matrices and
+dataclasses of them (:mod:`symcat.codegen.fingerprint`), a scene changed since the model was
+built from it (the model does not follow it: its digest then differs from the one the model
+kept), or a subclass of :class:`~symcat.assembly.multibody.MultibodyModel`, which may hold
+more. What the key cannot see is a change made to the assembled model's own internals (its
+kernel groups' values, its index maps) after it was built.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ..codegen.fingerprint import Undescribed, digest, scene_digest
+from ..codegen.paths import PACKAGE_DIR, atomic_write, cache_dir, generated_dir, manifest_path, regenerated_dir, \
+    tool_versions
+
+#: Version of the record's content (a change makes older records unreadable, not wrong).
+RECORD_VERSION = 2
+
+
+@lru_cache(maxsize=None)
+def _code_digest() -> bytes:
+    """What every compiled step follows from besides the model: symcat's Python source, the
+    shipped and regenerated kernels' manifests (their code's hashes) and the tools' versions.
+    Read once per process."""
+    h = hashlib.sha256()
+    for path in sorted(PACKAGE_DIR.rglob("*.py")):
+        h.update(str(path.relative_to(PACKAGE_DIR)).encode() + b"\0" + path.read_bytes())
+    for folder in (generated_dir(), regenerated_dir()):
+        manifest = manifest_path(folder)
+        h.update(manifest.read_bytes() if manifest.is_file() else b"-")
+    h.update(json.dumps(tool_versions(), sort_keys=True).encode())
+    return h.digest()
+
+
+def model_key(model, form, settings) -> str | None:
+    """The hex digest naming the compiled steps of ``model`` (its :class:`Formulation` ``form``)
+    under ``settings`` (the run's settings that shape the code, e.g. variant and spectral
+    radius), or None when the model cannot be described exactly (see the module's notes)."""
+    from ..assembly.multibody import MultibodyModel
+
+    if type(model) is not MultibodyModel:
+        return None
+    built = getattr(model, "scene_digest", None)
+    if built is None or scene_digest(model.scene) != built:  # (a scene changed after the model was built)
+        return None
+    try:
+        parts = [model.window_size, model.q0, model.v0, model.free, model.s0, model.sc0,
+                 np.asarray(form.q_fixed, float), form.formulation, form.index, form.cholesky, settings]
+        return hashlib.sha256(_code_digest() + built + digest(parts)).hexdigest()
+    except Undescribed:
+        return None
+
+
+def _record_path(key: str) -> Path:
+    return cache_dir() / f"alpha_chunk-model-{key[:40]}.json"
+
+
+def read_record(key: str | None) -> dict | None:
+    """The record of the compiled steps named ``key`` (:func:`write_record`), or None."""
+    if key is None:
+        return None
+    try:
+        record = json.loads(_record_path(key).read_text())
+    except (OSError, ValueError):
+        return None
+    if record.get("version") != RECORD_VERSION or record.get("key") != key:
+        return None
+    return record
+
+
+def write_record(key: str | None, library_key: str, mass_scale: float) -> None:
+    """Record that the model named ``key`` has the compiled steps whose library key digests to
+    ``library_key``, with the multipliers' tolerance scale ``mass_scale`` (kg) its runs start
+    from."""
+    if key is None:
+        return
+    record = {"version": RECORD_VERSION, "key": key, "library": library_key, "mass_scale": float(mass_scale)}
+    atomic_write(_record_path(key), json.dumps(record).encode())
