@@ -83,7 +83,7 @@ class Placement:
         return values[self.jac_nonzero] * self.jac_weight
 
     def touched(self, n_b: int) -> tuple[np.ndarray, np.ndarray, int]:
-        """``(keys, flat, k)`` of the capacitance (:meth:`.StepEquations.prepare`): the bulk
+        """``(keys, flat, k)`` of the capacitance (:meth:`.alpha_linear.StepSolve.prepare`): the bulk
         unknowns in a row or column of the Jacobian then the others from ``n_b``, and each
         Jacobian term's place in the ``k x k`` matrix on ``keys`` (row-major)."""
         found = self._touched.get(n_b)
