@@ -60,7 +60,8 @@ def source_path(library: Path) -> Path:
     return library.with_suffix(".c")
 
 
-def _lock_path(library: Path) -> Path:
+def lock_path(library: Path) -> Path:
+    """The lock file of the background job that compiles ``library`` (holding its process id)."""
     return library.with_suffix(".lock")
 
 
@@ -82,10 +83,13 @@ def _running(lock: Path) -> bool:
     return True
 
 
-def start_background(library: Path, flags: tuple = OPTIMIZED_FLAGS) -> bool:
+def start_background(library: Path, flags: tuple = OPTIMIZED_FLAGS, module: str = __name__) -> bool:
     """Start compiling :func:`source_path` of ``library`` into ``library`` with ``flags`` in a
-    background process, unless one runs already; True if one was started."""
-    lock = _lock_path(library)
+    background process, unless one runs already; True if one was started. ``module``: the
+    module whose ``__main__`` the process runs with the arguments ``library flags...`` (one that
+    first writes the C, e.g. :mod:`symcat.integrate.alpha_rest`, then calls
+    :func:`compile_waiting`)."""
+    lock = lock_path(library)
     for _ in range(2):
         try:
             fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
@@ -97,7 +101,7 @@ def start_background(library: Path, flags: tuple = OPTIMIZED_FLAGS) -> bool:
     else:
         return False
     try:
-        job = subprocess.Popen([sys.executable, "-m", "symcat.codegen.optimized", str(library), *flags],
+        job = subprocess.Popen([sys.executable, "-m", module, str(library), *flags],
                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                start_new_session=True)
         os.write(fd, str(job.pid).encode())
@@ -125,10 +129,14 @@ def wait_for_background(timeout_s: float = 300.0) -> bool:
     return True
 
 
-def _compile(library: Path, flags: tuple = OPTIMIZED_FLAGS) -> int:
+def failed_path(library: Path) -> Path:
+    """Where a background job that failed left its message (it would fail again)."""
+    return library.with_suffix(".failed")
+
+
+def compile_waiting(library: Path, flags: tuple = OPTIMIZED_FLAGS) -> int:
     """The background job: compile the waiting C into ``library`` with ``flags``, then remove
-    the C and the lock (also on failure, whose message is left in ``<library>.failed``: it
-    would fail again)."""
+    the C and the lock (also on failure, whose message is left in :func:`failed_path`)."""
     from .library import build_library, find_compiler
 
     source = source_path(library)
@@ -137,12 +145,12 @@ def _compile(library: Path, flags: tuple = OPTIMIZED_FLAGS) -> int:
         build_library(find_compiler(), flags, source, library)
         return 0
     except Exception as exc:  # noqa: BLE001 - reported in a file: nobody reads this process's stderr
-        library.with_suffix(".failed").write_text(f"{type(exc).__name__}: {exc}\n")
+        failed_path(library).write_text(f"{type(exc).__name__}: {exc}\n")
         return 1
     finally:
         source.unlink(missing_ok=True)
-        _lock_path(library).unlink(missing_ok=True)
+        lock_path(library).unlink(missing_ok=True)
 
 
 if __name__ == "__main__":
-    sys.exit(_compile(Path(sys.argv[1]), tuple(sys.argv[2:]) or OPTIMIZED_FLAGS))
+    sys.exit(compile_waiting(Path(sys.argv[1]), tuple(sys.argv[2:]) or OPTIMIZED_FLAGS))

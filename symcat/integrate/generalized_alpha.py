@@ -97,8 +97,9 @@ from .simulate import one_handler
 VARIANTS = ("index3", "stabilized")
 #: Steps from which a run with wheel/rail contacts compiles the rest of its steps to C when no
 #: compiled one is cached (:class:`~.alpha_step.StepEquations`); a shorter run uses a cached one
-#: or the expanded functions. Compiling the seed scene's takes about 30 s (once per machine and
-#: model); its compiled step then runs the scene about 1.5 times faster.
+#: or the expanded functions, and leaves the compiling to a background job for the model's next
+#: runs (:func:`.alpha_rest.compile_later`). Compiling the seed scene's takes about 30 s (once
+#: per machine and model); its compiled step then runs the scene about 1.5 times faster.
 COMPILE_STEPS = 2000
 #: Steps from which a run compiles its steps (:mod:`.alpha_chunk`) when they are not cached: the
 #: compiler's 5 to 50 s (once per model) against the Python steps' extra 0.5 to 2 ms each.
@@ -144,7 +145,7 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
     if handler is not None:
         stats = {"steps": 0, "nsteps": 0, "newton_iterations": 0, "factorizations": 0, "rebuilds": 0, "halvings": 0,
                  "build_s": 0.0, "dt": dt, "rho_inf": coef.rho_inf, "variant": variant, "restarts": 0}
-        # A short run uses a compiled step if one is cached and does not compile one.
+        # A short run uses a compiled step if one is cached, else compiles one in the background.
         rest = (True if compiled or t_end / dt >= COMPILE_STEPS else None) if compiled is not False else False
         integ = Integrator(model, form, coef, variant, tol, int(max_iterations), max_halvings, expand, stats, rest)
         try:
@@ -295,8 +296,8 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
         bodies, joints and contacts); with ``handlers``, compile the rest of each step. The
         code is compiled once per model and cached. None (default): compiled if cached or if
         the run has at least :data:`CHUNK_COMPILE_STEPS` steps (the rest of wheel/rail steps:
-        :data:`COMPILE_STEPS`); True: compiled now if not cached; False: every step evaluated
-        from Python.
+        :data:`COMPILE_STEPS`, and a shorter one has it compiled in the background for the
+        next runs); True: compiled now if not cached; False: every step evaluated from Python.
 
     Returns
     -------

@@ -138,3 +138,39 @@ def test_a_library_with_its_own_optimized_flags_is_compiled_with_them(cache):
     assert expected.name != cached_library("tiny", b"tiny", optimized.OPTIMIZED_FLAGS).name
     assert model_dae.compiled_library("tiny", b"tiny", write, "background", optimized_flags=flags) == expected
     assert float(ca.external("tiny", str(expected))(3.0)) == 10.0
+
+
+def test_a_short_runs_step_is_compiled_in_the_background_for_the_next_run(cache, monkeypatch):
+    """A generalized-alpha run too short to wait for the compiler (``compiled=None``) evaluates
+    the rest of its step expanded and leaves its graph to a background job; the model's next run
+    loads the library the job wrote and compiled, with the same values."""
+    from symcat.integrate.alpha_coefficients import AlphaCoefficients
+    from symcat.integrate.alpha_step import StepEquations
+
+    monkeypatch.setenv(optimized.OPTIMIZE_ENV, "background")
+    form = Formulation(_wheelset("conical", "linear"), "augmented", "1")
+    first = StepEquations(form, "stabilized", compiled=None)
+    assert first._rest.function.class_name() != "External"
+    assert optimized.wait_for_background(600.0)
+    for leftover in ("*.casadi", "*.c", "*.lock", "*.failed"):
+        assert not list(cache.glob(leftover)), leftover
+    assert len([n for n in _libraries(cache) if n.startswith("alpha_rest-")]) == 1
+    second = StepEquations(form, "stabilized", compiled=None)
+    assert second._rest.function.class_name() == "External"
+    model, c, h = form.model, AlphaCoefficients(0.9), 1e-3
+    u0 = np.r_[model.q0[model.free], model.s0]
+    rng = np.random.default_rng(3)
+    p = np.r_[u0, rng.normal(0, 1e-3, 2 * u0.size), 0.01, c.beta * h * h, c.gamma * h, (1 - c.alpha_m) / (1 - c.alpha_f)]
+    y = np.zeros(first.n_y)
+    y[: u0.size] = u0 + rng.normal(0, 1e-6, u0.size)
+    np.testing.assert_allclose(second.residual(y, p), first.residual(y, p), rtol=1e-10, atol=1e-9)
+    a, b = first.jacobian(y, p).toarray(), second.jacobian(y, p).toarray()
+    np.testing.assert_allclose(b, a, rtol=1e-10, atol=1e-10 * np.abs(a).max())
+
+
+def test_mode_off_leaves_no_background_job_for_a_short_run(cache, monkeypatch):
+    from symcat.integrate.alpha_step import StepEquations
+
+    monkeypatch.setenv(optimized.OPTIMIZE_ENV, "off")
+    StepEquations(Formulation(_wheelset("conical", "linear"), "augmented", "1"), "stabilized", compiled=None)
+    assert not list(cache.iterdir())
