@@ -83,6 +83,11 @@ def _running(lock: Path) -> bool:
     return True
 
 
+def jobs_running(folder: Path) -> bool:
+    """Whether a background job compiles into ``folder`` (any process's)."""
+    return any(_running(lock) for lock in folder.glob("*.lock"))
+
+
 def start_background(library: Path, flags: tuple = OPTIMIZED_FLAGS, module: str = __name__) -> bool:
     """Start compiling :func:`source_path` of ``library`` into ``library`` with ``flags`` in a
     background process, unless one runs already; True if one was started. ``module``: the

@@ -79,15 +79,17 @@ def _graph_path(library: Path) -> Path:
 def compile_later(rest: ca.Function, key: bytes) -> bool:
     """Leave ``rest`` (its library's cache ``key``) for a background job that writes its C and
     compiles the optimized library that :func:`compiled_rest` then finds; True if a job was
-    started (not in ``$SYMCAT_OPTIMIZE`` modes ``now`` and ``off``, nor when a job runs already
-    or one failed on this graph before)."""
+    started. Not in ``$SYMCAT_OPTIMIZE`` modes ``now`` and ``off``, nor when one failed on this
+    graph before, nor while any background job compiles into the cache: a study of many short
+    runs of different models (each its own graph) must not start as many compilers; a later
+    run starts the next."""
     from ..codegen import model_dae
-    from ..codegen.optimized import OPTIMIZED_FLAGS, failed_path, optimize_mode, start_background
+    from ..codegen.optimized import OPTIMIZED_FLAGS, failed_path, jobs_running, optimize_mode, start_background
 
     if optimize_mode() != "background":
         return False
     library = model_dae.cached_library("alpha_rest", key, OPTIMIZED_FLAGS)
-    if library.exists() or failed_path(library).exists():
+    if library.exists() or failed_path(library).exists() or jobs_running(library.parent):
         return False
     from ..codegen.paths import atomic_write
 

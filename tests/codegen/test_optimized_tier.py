@@ -1,6 +1,7 @@
 """The optimized tier of the model DAE libraries (symcat.codegen.optimized): compiled in the
 background after the -O0 library, loaded by later runs, equal in value; compiled at once in
 mode ``now``; never in mode ``off``; a dead compiler's job restarted, a failed one reported."""
+import os
 import subprocess
 import sys
 
@@ -174,3 +175,16 @@ def test_mode_off_leaves_no_background_job_for_a_short_run(cache, monkeypatch):
     monkeypatch.setenv(optimized.OPTIMIZE_ENV, "off")
     StepEquations(Formulation(_wheelset("conical", "linear"), "augmented", "1"), "stabilized", compiled=None)
     assert not list(cache.iterdir())
+
+
+def test_a_short_run_starts_no_second_compiler_while_one_runs(cache, monkeypatch):
+    """Short runs of several models (a study) start one background compiler at a time."""
+    from symcat.integrate import alpha_rest
+
+    monkeypatch.setenv(optimized.OPTIMIZE_ENV, "background")
+    busy = cache / "other.lock"
+    busy.write_text(str(os.getpid()))  # a live process compiling something else
+    y = ca.MX.sym("y", 2)
+    rest = ca.Function("alpha_rest", [y], [2 * y])
+    assert not alpha_rest.compile_later(rest, b"key")
+    assert not list(cache.glob("*.casadi"))
