@@ -283,8 +283,8 @@ class _PostTerms:
 
         self.form = form
         model = form.model
-        fn, self.patterns = _terms_function(form, light, contacts)
-        self._terms, self._names = _Mapped(fn), fn.name_out()
+        fn, self.patterns, self._terms = _mapped_terms(form, light, contacts)
+        self._names = fn.name_out()
         self.creep = _Mapped(form.creep_function()) if has_creep(model) else None
         self._normal = _Mapped(form.normal_direction_function()) if model.wheelrail else None
         self.normal_rows = form.normal_force_rows(full=True)  # the KKT multipliers have every row
@@ -339,6 +339,21 @@ class _PostTerms:
         colind, row = (np.asarray(x) for x in self.patterns["M"].get_ccs())
         return [spla.spsolve(sps.csc_matrix((m_nz, row, colind), shape=(n_f, n_f)), f)
                 for m_nz, f in zip(terms["M"], terms["Q"])]
+
+
+def _mapped_terms(form: Formulation, light: bool, contacts: bool) -> tuple[ca.Function, dict, _Mapped]:
+    """:func:`_terms_function` and its :class:`_Mapped` evaluations, kept for the next model of
+    the same digest and windows (:func:`~.alpha_chunk_cache.model_memo`): a run's model is built
+    anew, and building the function and its map over the outputs cost about as much as the
+    compiled steps of a coarse run on a small model."""
+    from .alpha_chunk_cache import model_memo
+
+    def build():
+        fn, patterns = _terms_function(form, light, contacts)
+        return fn, patterns, _Mapped(fn)
+
+    windows = tuple(sl.window for sl in form.model.windowed())
+    return model_memo(form.model, form, ("post terms", light, contacts, windows), build)
 
 
 def _terms_function(form: Formulation, light: bool = False, contacts: bool = True) -> tuple[ca.Function, dict]:
