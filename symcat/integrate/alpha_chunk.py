@@ -100,7 +100,7 @@ class CompiledSteps:
     def __init__(self, integ: Integrator, h: float, per: int, build: bool = True):
         self.integ, self.h, self.per, self.build = integ, h, min(int(per), MAX_STEPS), build
         self._fns = None  # length -> compiled function
-        self._factor = None  # the iteration matrix's factor the compiled steps carry
+        self._factors = None  # the iteration matrix's factor the compiled steps carry (see _prepare)
         self._renew = True  # factorize it at the next call's first step
         self._scale = None
         self._mass_scale = None  # the multipliers' tolerance scale of the compiled steps (kg)
@@ -180,7 +180,10 @@ class CompiledSteps:
         """The factor's storage (its size the library's), the packed state's layout and the
         Newton tolerance's scale."""
         n_u, n_c, n_sc, n_y = step_sizes(self.integ.form, self.integ.variant)
-        self._factor = np.zeros(self._fns[LENGTHS[0]].function.nnz_in(4))
+        # the factor the compiled steps carry, in two arrays that the calls take turns to read
+        # and write (no copies of it in and out of a call, :meth:`_call`)
+        size = self._fns[LENGTHS[0]].function.nnz_in(4)
+        self._factors = (np.zeros(size), np.zeros(size))
         self._cuts = np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc]).tolist()
         self._mass_scale = mass_scale
         model = self.integ.model
@@ -193,8 +196,12 @@ class CompiledSteps:
         ``min(n, per)`` steps from ``s`` at ``t``."""
         per, h = self.per, self.h
         length = next(L for L in LENGTHS if L >= min(n, per))
-        x, self._factor, its, factorizations = self._fns[length].nonzeros(
-            self._pack(s), t + h * np.arange(length), h, min(n, per), self._factor, float(self._renew), self._scale)
+        fn, (factor, other) = self._fns[length], self._factors
+        fn.bind({4: factor}, {1: other})
+        x, _, its, factorizations = fn.outputs(
+            self._pack(s), t + h * np.arange(length), h, min(n, per), factor, float(self._renew), self._scale)
+        self._factors = (other, factor)  # the factor the steps ended with is read by the next call
+        its = its.copy()
         self.integ.compiled_factorizations += int(factorizations[0])
         done = min(int(np.argmin(its > 0)) if its.min() <= 0 else length, n, per)
         self._renew = done < min(n, per)  # a failure: renew the matrix where the next call starts
@@ -208,8 +215,9 @@ class CompiledSteps:
         return np.concatenate([s.u, s.v, s.v_dot, s.a, s.lam, s.sc, a_prev, lam_prev, sc_prev, [s.h, 0.0]])
 
     def _unpack(self, x: np.ndarray) -> State:
+        """The state of the packed ``x`` (copied: ``x`` is the compiled function's output array)."""
         cuts = self._cuts
-        u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev = (x[i:j] for i, j in zip(cuts[:-1], cuts[1:]))
+        u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev = (x[i:j].copy() for i, j in zip(cuts[:-1], cuts[1:]))
         return State(u, v, v_dot, a, lam, sc, (a_prev, lam_prev, sc_prev), float(x[cuts[-1]]))
 
 
