@@ -197,9 +197,16 @@ class CompiledSteps:
         per, h = self.per, self.h
         length = next(L for L in LENGTHS if L >= min(n, per))
         fn, (factor, other) = self._fns[length], self._factors
+        packed = self._pack(s)
+        if self._renew:  # the matrix afresh at the first step's predictor
+            renew = self._fns["renew"]
+            renew.bind(outputs={0: other})
+            renew.outputs(packed, t, h)
+            factor, other = other, factor
+            self.integ.compiled_factorizations += 1
         fn.bind({4: factor}, {1: other})
         x, _, its, factorizations = fn.outputs(
-            self._pack(s), t + h * np.arange(length), h, min(n, per), factor, float(self._renew), self._scale)
+            packed, t + h * np.arange(length), h, min(n, per), factor, float(self._renew), self._scale)
         self._factors = (other, factor)  # the factor the steps ended with is read by the next call
         its = its.copy()
         self.integ.compiled_factorizations += int(factorizations[0])
@@ -270,14 +277,14 @@ def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> tuple
 
 
 class _Lengths(dict):
-    """The library's functions by length, loaded at first use (a run at one output interval
-    calls one or two of them)."""
+    """The library's functions by length (and ``"renew"``, the matrix at a step's predictor),
+    loaded at first use (a run at one output interval calls one or two of them)."""
 
     def __init__(self, path: Path):
         super().__init__()
         self.path = path
 
-    def __missing__(self, length: int) -> BufferedFunction:
+    def __missing__(self, length) -> BufferedFunction:
         fn = self[length] = BufferedFunction(ca.external(f"alpha_chunk_{length}", str(self.path)))
         return fn
 
@@ -291,10 +298,14 @@ def _graph(residual: ChunkResidual) -> ca.Function:
 def _chunk_functions(st: StepEquations, coef) -> list:
     """``alpha_chunk_<per>(x0, t (per), h, n, factor, renew, scale) -> (x, factor, iterations
     (per), factorizations)`` for each ``per`` of :data:`LENGTHS`: up to ``n`` steps of ``h``
-    from the packed state ``x0`` at the times ``t``, with the iteration matrix's ``factor`` (factorized at the first step's predictor if
-    ``renew``); ``x`` is the state after the last step that converged and ``factor`` the one
-    the steps ended with; a step's iterations are 0 (not taken: past ``n`` or after a failure)
-    or -1 (failed)."""
+    from the packed state ``x0`` at the times ``t``, with the iteration matrix's ``factor``
+    (``renew``: made at the first step's predictor, by ``alpha_chunk_renew``); ``x`` is the
+    state after the last step that converged and ``factor`` the one the steps ended with; a
+    step's iterations are 0 (not taken: past ``n`` or after a failure) or -1 (failed). Then
+    ``alpha_chunk_renew(x0, t0, h) -> factor``: the matrix at the predictor of the step from
+    ``x0`` at ``t0``, which the caller runs before a call that renews it (outside the steps:
+    inside, keeping the factor where it is not renewed copied it at every step, 128 kB on
+    the moving load)."""
     n_u, n_c, n_sc, n_y = st.n_u, st.n_c, st.n_sc, st.n_y
     n_x = 5 * n_u + 2 * (n_c + n_sc) + 2
     y, p = ca.MX.sym("y", n_y), ca.MX.sym("p", 3 * n_u + 4)
@@ -324,6 +335,22 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     rhs = ca.MX.sym("rhs", n_y)
     solve = ca.Function("alpha_chunk_solve", [factor, rhs], [layout.solve(factor, rhs)])
 
+    # The step's predictor: (packed state, t0, h) -> (y, p)
+    xk, t0, h = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h")
+    parts = ca.vertsplit(xk, np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc, 1, 1]).tolist())
+    u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev, h_prev, _ = parts
+    c = coef
+    bh2 = c.beta * h * h
+    p_k = ca.vertcat(u + h * v + h * h * (0.5 - c.beta) * a, v + h * (1 - c.gamma) * a,
+                     (c.alpha_m * a - c.alpha_f * v_dot) / (1 - c.alpha_f), t0 + h, bh2, c.gamma * h,
+                     (1 - c.alpha_m) / (1 - c.alpha_f))
+    ratio = h / h_prev
+    y_k = ca.vertcat(p_k[:n_u] + bh2 * (a + ratio * (a - a_prev)), bh2 * (lam + ratio * (lam - lam_prev)),
+                     ca.MX(n_y - n_u - n_c - n_sc, 1), sc + ratio * (sc - sc_prev))
+    predictor = ca.Function("alpha_chunk_predictor", [xk, t0, h], [y_k, p_k])
+    # the matrix afresh at a step's predictor (run by the caller before a call that renews it)
+    renew_matrix = ca.Function("alpha_chunk_renew", [xk, t0, h], [factorize(y_k, p_k, ca.MX(layout.size, 1))])
+
     # One Newton iteration: (y, previous error, status, count, fresh) -> (y, error, status,
     # count); status 0 running, 1 converged, 2 failed, 3 slow (wants a fresh matrix): the
     # tests of solve_step. fresh: the matrix was factorized in this step. scale: the Newton
@@ -345,9 +372,9 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     iterate = ca.Function("alpha_chunk_iteration", args, [y + dy, err, new_status, count + 1])
     keep = ca.Function("alpha_chunk_keep", args, [y, prev, status, count])
     newton = ca.Function.if_else("alpha_chunk_newton", keep, iterate)
-
     # One step: (packed state, factor, renew, t0, h, index, n, scale) -> (state, factor,
-    # iterations, factorizations)
+    # iterations, factorizations); renew: the factor was made at this step's predictor
+    # (alpha_chunk_renew, which the caller runs when the matrix is to be renewed)
     xk, t0, h, index, n = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h"), ca.MX.sym("k"), ca.MX.sym("n")
     # scale: the Newton tolerance of each unknown, then per round the contraction above which
     # the iteration counts as slow
@@ -357,17 +384,11 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev, h_prev, was_failed = parts
     c = coef
     bh2 = c.beta * h * h
-    p_k = ca.vertcat(u + h * v + h * h * (0.5 - c.beta) * a, v + h * (1 - c.gamma) * a,
-                     (c.alpha_m * a - c.alpha_f * v_dot) / (1 - c.alpha_f), t0 + h, bh2, c.gamma * h,
-                     (1 - c.alpha_m) / (1 - c.alpha_f))
-    ratio = h / h_prev
-    y_k = ca.vertcat(p_k[:n_u] + bh2 * (a + ratio * (a - a_prev)), bh2 * (lam + ratio * (lam - lam_prev)),
-                     ca.MX(n_y - n_u - n_c - n_sc, 1), sc + ratio * (sc - sc_prev))
+    y_k, p_k = predictor(xk, t0, h)
     active = ca.logic_and(index < n, was_failed == 0)
-    wanted = ca.logic_and(active, renew)
-    f_k = refresh(wanted, y_k, p_k, factor)
-    fr, factorizations = wanted, wanted
+    fr = ca.logic_and(active, renew)
     e, stat, cnt = ca.MX(0), ca.if_else(active, 0, 1), ca.MX(0)  # an inactive step: "converged" untouched
+    f_k, factorizations = factor, ca.MX(0)
     for round_ in range(ROUNDS):
         round_scale = ca.vertcat(scale[:n_y], scale[n_y + round_])
         for _ in range(MAX_ITERATIONS // ROUNDS):
@@ -405,7 +426,7 @@ def _chunk_functions(st: StepEquations, coef) -> list:
             total += fk
         functions.append(ca.Function(f"alpha_chunk_{per}", [x0, times, h, n, factor, renew, scale],
                                      [x, f_out, ca.vertcat(*counts), total]))
-    return functions
+    return functions + [renew_matrix]
 
 
 def _layout(st: StepEquations, couplings: tuple | None = None) -> BorderedBand:
