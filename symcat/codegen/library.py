@@ -200,13 +200,15 @@ class BufferedFunction:
         factorization carried by compiled steps) then moves by swapping two arrays instead of
         being copied in and out. An input passed as its bound array itself is not copied."""
         for i, a in (inputs or {}).items():
-            self._check_bound(a, self.function.nnz_in(i))
-            self._inputs[i] = a
-            self._buffer.set_arg(i, memoryview(a))
+            if a is not self._inputs[i]:
+                self._check_bound(a, self._inputs[i].size)
+                self._inputs[i] = a
+                self._buffer.set_arg(i, memoryview(a))
         for i, a in (outputs or {}).items():
-            self._check_bound(a, self.function.nnz_out(i))
-            self._outputs[i] = a
-            self._buffer.set_res(i, memoryview(a))
+            if a is not self._outputs[i]:
+                self._check_bound(a, self._outputs[i].size)
+                self._outputs[i] = a
+                self._buffer.set_res(i, memoryview(a))
 
     @staticmethod
     def _check_bound(a, size: int) -> None:

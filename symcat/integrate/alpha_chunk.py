@@ -102,6 +102,7 @@ class CompiledSteps:
         self._fns = None  # length -> compiled function
         self._factors = None  # the iteration matrix's factor the compiled steps carry (see _prepare)
         self._renew = True  # factorize it at the next call's first step
+        self._last = None  # (state, packed) of the last call (see _call)
         self._scale = None
         self._mass_scale = None  # the multipliers' tolerance scale of the compiled steps (kg)
         # The model's record (:mod:`.alpha_chunk_cache`): its library is found without the
@@ -197,7 +198,8 @@ class CompiledSteps:
         per, h = self.per, self.h
         length = next(L for L in LENGTHS if L >= min(n, per))
         fn, (factor, other) = self._fns[length], self._factors
-        packed = self._pack(s)
+        last = self._last  # (the state the last call gave, packed): the next call's input as it is
+        packed = last[1] if last is not None and last[0] is s else self._pack(s)
         if self._renew:  # the matrix afresh at the first step's predictor
             renew = self._fns["renew"]
             renew.bind(outputs={0: other})
@@ -213,7 +215,8 @@ class CompiledSteps:
         done = min(int(np.argmin(its > 0)) if its.min() <= 0 else length, n, per)
         self._renew = done < min(n, per)  # a failure: renew the matrix where the next call starts
         if done:
-            s = self._unpack(x)
+            s, x = self._unpack(x)
+            self._last = (s, x)
         return done, s, int(its[:done].sum())
 
     # --- the packed state: u v v_dot a lam sc a_prev lam_prev sc_prev h failed --------------
@@ -221,11 +224,12 @@ class CompiledSteps:
         a_prev, lam_prev, sc_prev = s.prev
         return np.concatenate([s.u, s.v, s.v_dot, s.a, s.lam, s.sc, a_prev, lam_prev, sc_prev, [s.h, 0.0]])
 
-    def _unpack(self, x: np.ndarray) -> State:
-        """The state of the packed ``x`` (copied: ``x`` is the compiled function's output array)."""
-        cuts = self._cuts
-        u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev = (x[i:j].copy() for i, j in zip(cuts[:-1], cuts[1:]))
-        return State(u, v, v_dot, a, lam, sc, (a_prev, lam_prev, sc_prev), float(x[cuts[-1]]))
+    def _unpack(self, x: np.ndarray) -> tuple[State, np.ndarray]:
+        """``(state, x)``: the state of the packed ``x``, and ``x`` copied (it is the compiled
+        function's output array), of which the state's arrays are views."""
+        cuts, x = self._cuts, x.copy()
+        u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev = (x[i:j] for i, j in zip(cuts[:-1], cuts[1:]))
+        return State(u, v, v_dot, a, lam, sc, (a_prev, lam_prev, sc_prev), float(x[cuts[-1]])), x
 
 
 def step_sizes(form, variant: str) -> tuple[int, int, int, int]:
@@ -374,16 +378,12 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     newton = ca.Function.if_else("alpha_chunk_newton", keep, iterate)
     # One step: (packed state, factor, renew, t0, h, index, n, scale) -> (state, factor,
     # iterations, factorizations); renew: the factor was made at this step's predictor
-    # (alpha_chunk_renew, which the caller runs when the matrix is to be renewed)
     xk, t0, h, index, n = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h"), ca.MX.sym("k"), ca.MX.sym("n")
-    # scale: the Newton tolerance of each unknown, then per round the contraction above which
-    # the iteration counts as slow
-    scale = ca.MX.sym("scale", n_y + ROUNDS)
+    scale = ca.MX.sym("scale", n_y + ROUNDS)  # then per round the contraction that is slow
     renew = ca.MX.sym("renew")
     parts = ca.vertsplit(xk, np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc, 1, 1]).tolist())
     u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev, h_prev, was_failed = parts
-    c = coef
-    bh2 = c.beta * h * h
+    bh2 = coef.beta * h * h
     y_k, p_k = predictor(xk, t0, h)
     active = ca.logic_and(index < n, was_failed == 0)
     fr = ca.logic_and(active, renew)
