@@ -40,6 +40,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+from ..codegen.band_c import include_in
 from ..codegen.library import BufferedFunction, symbolic_kernels, write_functions_c
 from ..errors import CompilerError
 from .alpha_bulk import step_data
@@ -89,7 +90,8 @@ OPTIMIZED_FLAGS = ("-O2", "-fPIC", "-shared")
 #: The code the compiled library follows from (this module, the residual, the factorization and
 #: the proxies), part of its cache key.
 _SOURCE = b"".join((Path(__file__).parent / name).read_bytes()
-                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "bordered_band.py", "alpha_proxies.py"))
+                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "bordered_band.py", "alpha_proxies.py",
+                                "../codegen/band_c.py"))
 
 
 class CompiledSteps:
@@ -228,6 +230,7 @@ class CompiledSteps:
         """``(state, x)``: the state of the packed ``x``, and ``x`` copied (it is the compiled
         function's output array), of which the state's arrays are views."""
         cuts, x = self._cuts, x.copy()
+        x[-1] = 0.0  # (the failed flag, set when a later step of the call failed: a state to start from)
         u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev = (x[i:j] for i, j in zip(cuts[:-1], cuts[1:]))
         return State(u, v, v_dot, a, lam, sc, (a_prev, lam_prev, sc_prev), float(x[cuts[-1]])), x
 
@@ -271,7 +274,8 @@ def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> tuple
     def write(folder):
         with symbolic_kernels():
             fns = _chunk_functions(st, coef)
-        return write_functions_c(fns, "alpha_chunk", folder)
+        # the code calls the band's C kernels by name: their source with it
+        return include_in(write_functions_c(fns, "alpha_chunk", folder))
 
     path = compiled_library("alpha_chunk", key.encode(), write, build=build,  # -O0 first, optimized in the background
                             optimized_flags=OPTIMIZED_FLAGS)
