@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 import symcat.integrate.alpha_chunk_cache as cache
-import symcat.integrate.results as results
+import symcat.integrate.post_terms as results
 from symcat.dae.formulation import Formulation
 from symcat.dae.initial import _terms_function, consistent_state
 from symcat.integrate.generalized_alpha import generalized_alpha
@@ -65,3 +65,35 @@ def test_the_memo_is_bounded_and_a_model_without_a_key_builds_every_time(monkeyp
     cache.model_memo(changed, form, ("x",), lambda: calls.append(1))
     cache.model_memo(changed, form, ("x",), lambda: calls.append(1))
     assert calls == [1, 1]
+
+
+def test_compiled_post_terms_give_the_virtual_machines_results(monkeypatch):
+    """A run whose steps are compiled has its result's terms compiled (post_terms): the same
+    energies, drifts and reactions as the terms in CasADi's virtual machine."""
+    monkeypatch.setattr(cache, "_MEMO", type(cache._MEMO)())
+    calls = []
+    original = results._compiled_terms
+
+    def counted(*args):
+        fn = original(*args)
+        calls.append(fn)
+        return fn
+
+    monkeypatch.setattr(results, "_compiled_terms", counted)
+    compiled = generalized_alpha(moving_load(), 0.05, 1e-3, rho_inf=1.0, n_out=5, progress=False, tol=1e-10,
+                                 multipliers="integrator", compiled=True)
+    assert compiled.stats["compiled_steps"] > 0 and len(calls) == 1 and calls[0] is not None
+    plain = _run(moving_load())  # Python steps: the terms in the virtual machine
+    assert len(calls) == 1
+    assert np.allclose(compiled.q, plain.q, atol=1e-8)
+    # the result's terms of the same states, both ways
+    monkeypatch.setattr(cache, "_MEMO", type(cache._MEMO)())
+    form = Formulation(moving_load(), "augmented", "1")
+    fn, _, vm = results.mapped_terms(form, True, True, compiled=False)
+    _, _, cc = results.mapped_terms(form, True, True, compiled=True)
+    assert cc.fn is not vm.fn and cc.fn.name() == "post_terms"
+    rng = np.random.default_rng(1)
+    args = [rng.normal(scale=1e-3, size=(7, fn.nnz_in(i))) for i in range(fn.n_in())]
+    args[0] = args[0] + np.asarray(form.to_internal(form.model.q0[form.model.free]))
+    for a, b in zip(vm(*args), cc(*args)):
+        assert np.allclose(a, b, rtol=1e-12, atol=1e-9 * (1 + np.abs(a).max(initial=0)))
