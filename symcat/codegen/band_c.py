@@ -176,13 +176,24 @@ def _library(text: str) -> Path:
     return target
 
 
+#: CasADi's copy loop (``casadi_copy``), one element at a time, and what replaces it.
+_COPY_LOOP = "for (i=0; i<n; ++i) *y++ = *x++;"
+_COPY = "memmove(y, x, n * sizeof(casadi_real));"
+
+
 def include_in(c_path: Path) -> Path:
     """Append to the generated ``c_path`` the source of every kernel of this module it calls
-    (CasADi's code declares and calls them by name)."""
+    (CasADi's code declares and calls them by name), and make its copies ``memmove``: CasADi's
+    ``casadi_copy`` loop moves one number per instruction, and the compiled steps copy their
+    factor (16k numbers on the moving load) three times a step; the C library's copy is
+    several times faster. Nothing else of the generated code changes."""
     text = c_path.read_text()
-    with open(c_path, "a") as out:
-        for n, bw in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_band_(?:lu|solve)_(\d+)_(\d+)\(", text)}):
-            out.write(source(n, bw))
-        for m, n in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_matvec_(\d+)_(\d+)\(", text)}):
-            out.write(matvec_source(m, n))
+    if _COPY_LOOP in text:
+        text = "#include <string.h>\n" + text.replace(_COPY_LOOP, _COPY)
+    parts = [text]
+    for n, bw in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_band_(?:lu|solve)_(\d+)_(\d+)\(", text)}):
+        parts.append(source(n, bw))
+    for m, n in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_matvec_(\d+)_(\d+)\(", text)}):
+        parts.append(matvec_source(m, n))
+    c_path.write_text("".join(parts))
     return c_path

@@ -69,6 +69,7 @@ def test_generated_code_that_calls_the_kernels_gets_their_source(tmp_path):
     for name in ("symcat_band_lu_7_2", "symcat_band_solve_7_2", "symcat_matvec_3_4"):
         assert f"int {name}(const casadi_real** arg" in text  # defined, not only declared
     assert "symcat_matvec_3_5" not in text
+    assert "void casadi_copy" not in text or "memmove(y, x, n * sizeof(casadi_real));" in text
     # and it compiles (CasADi's declarations and these definitions agree)
     done = subprocess.run([find_compiler(), "-c", str(path), "-o", str(tmp_path / "caller.o")], capture_output=True)
     assert done.returncode == 0, done.stderr.decode()
