@@ -179,6 +179,11 @@ def _library(text: str) -> Path:
 #: CasADi's copy loop (``casadi_copy``), one element at a time, and what replaces it.
 _COPY_LOOP = "for (i=0; i<n; ++i) *y++ = *x++;"
 _COPY = "memmove(y, x, n * sizeof(casadi_real));"
+#: CasADi's ``casadi_fmax`` calls the C library's ``fmax`` (not inlined without -ffast-math:
+#: a call per use, a few hundred in a step's code); the same result inline: the other argument
+#: when one is NaN.
+_FMAX = "  return fmax(x, y);"
+_FMAX_INLINE = "  return (x > y || y != y) ? x : y;"
 
 
 def include_in(c_path: Path) -> Path:
@@ -186,10 +191,12 @@ def include_in(c_path: Path) -> Path:
     (CasADi's code declares and calls them by name), and make its copies ``memmove``: CasADi's
     ``casadi_copy`` loop moves one number per instruction, and the compiled steps copy their
     factor (16k numbers on the moving load) three times a step; the C library's copy is
-    several times faster. Nothing else of the generated code changes."""
+    several times faster. ``casadi_fmax`` is made inline (:data:`_FMAX`). Nothing else of the
+    generated code changes."""
     text = c_path.read_text()
     if _COPY_LOOP in text:
         text = "#include <string.h>\n" + text.replace(_COPY_LOOP, _COPY)
+    text = text.replace(_FMAX, _FMAX_INLINE)
     parts = [text]
     for n, bw in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_band_(?:lu|solve)_(\d+)_(\d+)\(", text)}):
         parts.append(source(n, bw))

@@ -84,8 +84,10 @@ MAX_BAND_WORK = 60_000
 #: The optimized tier's flags (:mod:`symcat.codegen.optimized`; the models' DAEs use -Og): the
 #: steps are a few thousand operations run millions of times, where -O2's scheduling takes a
 #: tenth to a seventh off the run, for a compiler time (in the background) about three times
-#: -Og's.
-OPTIMIZED_FLAGS = ("-O2", "-fPIC", "-shared")
+#: -Og's; -fno-semantic-interposition lets the compiler inline CasADi's helpers (``casadi_sq``,
+#: called over a thousand times in a step's code, is otherwise a call through the library's
+#: symbol table each time).
+OPTIMIZED_FLAGS = ("-O2", "-fno-semantic-interposition", "-fPIC", "-shared")
 
 #: The code the compiled library follows from (this module, the residual, the factorization and
 #: the proxies), part of its cache key.
