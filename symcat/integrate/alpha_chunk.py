@@ -81,13 +81,11 @@ MAX_BORDER = 60
 #: against their arithmetic).
 MAX_BAND_WORK = 60_000
 
-#: The optimized tier's flags (:mod:`symcat.codegen.optimized`; the models' DAEs use -Og): the
-#: steps are a few thousand operations run millions of times, where -O2's scheduling takes a
-#: tenth to a seventh off the run, for a compiler time (in the background) about three times
-#: -Og's; -fno-semantic-interposition lets the compiler inline CasADi's helpers (``casadi_sq``,
-#: called over a thousand times in a step's code, is otherwise a call through the library's
-#: symbol table each time).
-OPTIMIZED_FLAGS = ("-O2", "-fno-semantic-interposition", "-fPIC", "-shared")
+#: The optimized tier's flags (:mod:`symcat.codegen.optimized`; the DAEs use -Og): steps run
+#: millions of times, where -O3's scheduling and vectorization of the wires' long straight-line
+#: residual pay for its compiler time; -fno-semantic-interposition inlines CasADi's helpers
+#: (``casadi_sq``, used a thousand times in a step, is else a call through the symbol table).
+OPTIMIZED_FLAGS = ("-O3", "-fno-semantic-interposition", "-fPIC", "-shared")
 
 #: The code the compiled library follows from (this module, the residual, the factorization and
 #: the proxies), part of its cache key.
@@ -185,8 +183,7 @@ class CompiledSteps:
         """The factor's storage (its size the library's), the packed state's layout and the
         Newton tolerance's scale."""
         n_u, n_c, n_sc, n_y = step_sizes(self.integ.form, self.integ.variant)
-        # the factor the compiled steps carry, in two arrays that the calls take turns to read
-        # and write (no copies of it in and out of a call, :meth:`_call`)
+        # the factor in two arrays the calls take turns to read and write (no copies, _call)
         size = self._fns[LENGTHS[0]].function.nnz_in(4)
         self._factors = (np.zeros(size), np.zeros(size))
         self._cuts = np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc]).tolist()
@@ -213,8 +210,7 @@ class CompiledSteps:
         fn.bind({4: factor}, {1: other})
         x, _, its, factorizations = fn.outputs(
             packed, t + h * np.arange(length), h, min(n, per), factor, float(self._renew), self._scale)
-        self._factors = (other, factor)  # the factor the steps ended with is read by the next call
-        its = its.copy()
+        self._factors, its = (other, factor), its.copy()  # the factor the steps ended with: the next call's
         self.integ.compiled_factorizations += int(factorizations[0])
         done = min(int(np.argmin(its > 0)) if its.min() <= 0 else length, n, per)
         self._renew = done < min(n, per)  # a failure: renew the matrix where the next call starts
@@ -229,8 +225,7 @@ class CompiledSteps:
         return np.concatenate([s.u, s.v, s.v_dot, s.a, s.lam, s.sc, a_prev, lam_prev, sc_prev, [s.h, 0.0]])
 
     def _unpack(self, x: np.ndarray) -> tuple[State, np.ndarray]:
-        """``(state, x)``: the state of the packed ``x``, and ``x`` copied (it is the compiled
-        function's output array), of which the state's arrays are views."""
+        """``(state, x)``: the state of the packed ``x`` (views of ``x`` copied, the output array)."""
         cuts, x = self._cuts, x.copy()
         x[-1] = 0.0  # (the failed flag, set when a later step of the call failed: a state to start from)
         u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev = (x[i:j] for i, j in zip(cuts[:-1], cuts[1:]))
@@ -287,8 +282,7 @@ def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> tuple
 
 
 class _Lengths(dict):
-    """The library's functions by length (and ``"renew"``, the matrix at a step's predictor),
-    loaded at first use (a run at one output interval calls one or two of them)."""
+    """The library's functions by length (and ``"renew"``), loaded at first use."""
 
     def __init__(self, path: Path):
         super().__init__()
