@@ -60,8 +60,9 @@ NOTES = [
     "load's points on one proxy element that the code fills with the element holding them). symcat's "
     "runs keep the integrator's own multipliers (no KKT solve per output), as Exudyn reports only its "
     "sensors; each model's compiled library is built before the timed runs, as the kernels are, in its "
-    "optimized tier (-O2; 20 to 90 s once per model; a user's first run takes the -O0 library while the "
-    "optimized one compiles in the background). Every timed run builds its model anew and finds that "
+    "optimized tier (-O3, the band's factorization and solves C loops: about 20 s once for the moving load's "
+    "model; a user's first run takes the -O0 library while the optimized one compiles in the background); "
+    "so are the terms of a run's result when its steps are compiled (a few seconds once per model). Every timed run builds its model anew and finds that "
     "library from a digest of the model (`symcat.integrate.alpha_chunk_cache`), without building the "
     "Python step equations, which only a step that falls back to Python (or the start filter when "
     "rho_inf < 1, as on the pendulum) builds.",

@@ -193,9 +193,38 @@ class BufferedFunction:
         self._evaluate(args)
         return [nz.copy() for nz in self._outputs]
 
+    def bind(self, inputs: dict | None = None, outputs: dict | None = None) -> None:
+        """Evaluate input ``i`` from, and write output ``i`` into, the caller's own array
+        (``{i: array}``: contiguous float64 of the right size, kept alive by the caller and
+        only written in place): a large argument passed from one call to the next (a
+        factorization carried by compiled steps) then moves by swapping two arrays instead of
+        being copied in and out. An input passed as its bound array itself is not copied."""
+        for i, a in (inputs or {}).items():
+            if a is not self._inputs[i]:
+                self._check_bound(a, self._inputs[i].size)
+                self._inputs[i] = a
+                self._buffer.set_arg(i, memoryview(a))
+        for i, a in (outputs or {}).items():
+            if a is not self._outputs[i]:
+                self._check_bound(a, self._outputs[i].size)
+                self._outputs[i] = a
+                self._buffer.set_res(i, memoryview(a))
+
+    @staticmethod
+    def _check_bound(a, size: int) -> None:
+        if not (isinstance(a, np.ndarray) and a.dtype == np.float64 and a.flags.c_contiguous and a.size == size):
+            raise ValueError(f"bind: a contiguous float64 array of {size} entries is needed")
+
+    def outputs(self, *args) -> list[np.ndarray]:
+        """The outputs' nonzeros at the inputs ``args`` in the function's own arrays (and the
+        caller's bound ones, :meth:`bind`), not copied: valid until the next call."""
+        self._evaluate(args)
+        return self._outputs
+
     def _evaluate(self, args) -> None:
         for a, v in zip(self._inputs, args):
-            a[:] = v
+            if a is not v:
+                a[:] = v
         self._eval()
         if self._buffer.ret():
             self.function(*args)  # raises CasADi's own error

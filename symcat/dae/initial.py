@@ -20,11 +20,16 @@ from .formulation import Formulation, normal_forces_numeric
 
 def _terms_function(form: Formulation) -> ca.Function:
     """The terms of ``form`` as one function, built once per element window (a contact driver
-    projects after every jump: building it took 40 ms each time on the vehicle)."""
+    projects after every jump: building it took 40 ms each time on the vehicle) and kept for
+    the next model of the same digest (:func:`~symcat.integrate.alpha_chunk_cache.model_memo`)."""
+    from ..integrate.alpha_chunk_cache import model_memo
+
     key = tuple(sl.window for sl in form.model.windowed())
     cached = getattr(form, "_initial_terms", None)
     if cached is None or cached[0] != key:
-        cached = form._initial_terms = (key, _build_terms_function(form))
+        # (and once per process for models of one digest: a run's model is built anew)
+        fn = model_memo(form.model, form, ("initial terms", key), lambda: _build_terms_function(form))
+        cached = form._initial_terms = (key, fn)
     return cached[1]
 
 

@@ -40,6 +40,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+from ..codegen.band_c import include_in
 from ..codegen.library import BufferedFunction, symbolic_kernels, write_functions_c
 from ..errors import CompilerError
 from .alpha_bulk import step_data
@@ -80,16 +81,17 @@ MAX_BORDER = 60
 #: against their arithmetic).
 MAX_BAND_WORK = 60_000
 
-#: The optimized tier's flags (:mod:`symcat.codegen.optimized`; the models' DAEs use -Og): the
-#: steps are a few thousand operations run millions of times, where -O2's scheduling takes a
-#: tenth to a seventh off the run, for a compiler time (in the background) about three times
-#: -Og's.
-OPTIMIZED_FLAGS = ("-O2", "-fPIC", "-shared")
+#: The optimized tier's flags (:mod:`symcat.codegen.optimized`; the DAEs use -Og): steps run
+#: millions of times, where -O3's scheduling and vectorization of the wires' long straight-line
+#: residual pay for its compiler time; -fno-semantic-interposition inlines CasADi's helpers
+#: (``casadi_sq``, used a thousand times in a step, is else a call through the symbol table).
+OPTIMIZED_FLAGS = ("-O3", "-fno-semantic-interposition", "-fPIC", "-shared")
 
 #: The code the compiled library follows from (this module, the residual, the factorization and
 #: the proxies), part of its cache key.
 _SOURCE = b"".join((Path(__file__).parent / name).read_bytes()
-                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "bordered_band.py", "alpha_proxies.py"))
+                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "bordered_band.py", "alpha_proxies.py",
+                                "../codegen/band_c.py"))
 
 
 class CompiledSteps:
@@ -100,8 +102,9 @@ class CompiledSteps:
     def __init__(self, integ: Integrator, h: float, per: int, build: bool = True):
         self.integ, self.h, self.per, self.build = integ, h, min(int(per), MAX_STEPS), build
         self._fns = None  # length -> compiled function
-        self._factor = None  # the iteration matrix's factor the compiled steps carry
+        self._factors = None  # the iteration matrix's factor the compiled steps carry (see _prepare)
         self._renew = True  # factorize it at the next call's first step
+        self._last = None  # (state, packed) of the last call (see _call)
         self._scale = None
         self._mass_scale = None  # the multipliers' tolerance scale of the compiled steps (kg)
         # The model's record (:mod:`.alpha_chunk_cache`): its library is found without the
@@ -180,7 +183,9 @@ class CompiledSteps:
         """The factor's storage (its size the library's), the packed state's layout and the
         Newton tolerance's scale."""
         n_u, n_c, n_sc, n_y = step_sizes(self.integ.form, self.integ.variant)
-        self._factor = np.zeros(self._fns[LENGTHS[0]].function.nnz_in(4))
+        # the factor in two arrays the calls take turns to read and write (no copies, _call)
+        size = self._fns[LENGTHS[0]].function.nnz_in(4)
+        self._factors = (np.zeros(size), np.zeros(size))
         self._cuts = np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc]).tolist()
         self._mass_scale = mass_scale
         model = self.integ.model
@@ -193,13 +198,25 @@ class CompiledSteps:
         ``min(n, per)`` steps from ``s`` at ``t``."""
         per, h = self.per, self.h
         length = next(L for L in LENGTHS if L >= min(n, per))
-        x, self._factor, its, factorizations = self._fns[length].nonzeros(
-            self._pack(s), t + h * np.arange(length), h, min(n, per), self._factor, float(self._renew), self._scale)
+        fn, (factor, other) = self._fns[length], self._factors
+        last = self._last  # (the state the last call gave, packed): the next call's input as it is
+        packed = last[1] if last is not None and last[0] is s else self._pack(s)
+        if self._renew:  # the matrix afresh at the first step's predictor
+            renew = self._fns["renew"]
+            renew.bind(outputs={0: other})
+            renew.outputs(packed, t, h)
+            factor, other = other, factor
+            self.integ.compiled_factorizations += 1
+        fn.bind({4: factor}, {1: other})
+        x, _, its, factorizations = fn.outputs(
+            packed, t + h * np.arange(length), h, min(n, per), factor, float(self._renew), self._scale)
+        self._factors, its = (other, factor), its.copy()  # the factor the steps ended with: the next call's
         self.integ.compiled_factorizations += int(factorizations[0])
         done = min(int(np.argmin(its > 0)) if its.min() <= 0 else length, n, per)
         self._renew = done < min(n, per)  # a failure: renew the matrix where the next call starts
         if done:
-            s = self._unpack(x)
+            s, x = self._unpack(x)
+            self._last = (s, x)
         return done, s, int(its[:done].sum())
 
     # --- the packed state: u v v_dot a lam sc a_prev lam_prev sc_prev h failed --------------
@@ -207,10 +224,12 @@ class CompiledSteps:
         a_prev, lam_prev, sc_prev = s.prev
         return np.concatenate([s.u, s.v, s.v_dot, s.a, s.lam, s.sc, a_prev, lam_prev, sc_prev, [s.h, 0.0]])
 
-    def _unpack(self, x: np.ndarray) -> State:
-        cuts = self._cuts
+    def _unpack(self, x: np.ndarray) -> tuple[State, np.ndarray]:
+        """``(state, x)``: the state of the packed ``x`` (views of ``x`` copied, the output array)."""
+        cuts, x = self._cuts, x.copy()
+        x[-1] = 0.0  # (the failed flag, set when a later step of the call failed: a state to start from)
         u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev = (x[i:j] for i, j in zip(cuts[:-1], cuts[1:]))
-        return State(u, v, v_dot, a, lam, sc, (a_prev, lam_prev, sc_prev), float(x[cuts[-1]]))
+        return State(u, v, v_dot, a, lam, sc, (a_prev, lam_prev, sc_prev), float(x[cuts[-1]])), x
 
 
 def step_sizes(form, variant: str) -> tuple[int, int, int, int]:
@@ -252,7 +271,8 @@ def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> tuple
     def write(folder):
         with symbolic_kernels():
             fns = _chunk_functions(st, coef)
-        return write_functions_c(fns, "alpha_chunk", folder)
+        # the code calls the band's C kernels by name: their source with it
+        return include_in(write_functions_c(fns, "alpha_chunk", folder))
 
     path = compiled_library("alpha_chunk", key.encode(), write, build=build,  # -O0 first, optimized in the background
                             optimized_flags=OPTIMIZED_FLAGS)
@@ -262,14 +282,13 @@ def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> tuple
 
 
 class _Lengths(dict):
-    """The library's functions by length, loaded at first use (a run at one output interval
-    calls one or two of them)."""
+    """The library's functions by length (and ``"renew"``), loaded at first use."""
 
     def __init__(self, path: Path):
         super().__init__()
         self.path = path
 
-    def __missing__(self, length: int) -> BufferedFunction:
+    def __missing__(self, length) -> BufferedFunction:
         fn = self[length] = BufferedFunction(ca.external(f"alpha_chunk_{length}", str(self.path)))
         return fn
 
@@ -283,10 +302,14 @@ def _graph(residual: ChunkResidual) -> ca.Function:
 def _chunk_functions(st: StepEquations, coef) -> list:
     """``alpha_chunk_<per>(x0, t (per), h, n, factor, renew, scale) -> (x, factor, iterations
     (per), factorizations)`` for each ``per`` of :data:`LENGTHS`: up to ``n`` steps of ``h``
-    from the packed state ``x0`` at the times ``t``, with the iteration matrix's ``factor`` (factorized at the first step's predictor if
-    ``renew``); ``x`` is the state after the last step that converged and ``factor`` the one
-    the steps ended with; a step's iterations are 0 (not taken: past ``n`` or after a failure)
-    or -1 (failed)."""
+    from the packed state ``x0`` at the times ``t``, with the iteration matrix's ``factor``
+    (``renew``: made at the first step's predictor, by ``alpha_chunk_renew``); ``x`` is the
+    state after the last step that converged and ``factor`` the one the steps ended with; a
+    step's iterations are 0 (not taken: past ``n`` or after a failure) or -1 (failed). Then
+    ``alpha_chunk_renew(x0, t0, h) -> factor``: the matrix at the predictor of the step from
+    ``x0`` at ``t0``, which the caller runs before a call that renews it (outside the steps:
+    inside, keeping the factor where it is not renewed copied it at every step, 128 kB on
+    the moving load)."""
     n_u, n_c, n_sc, n_y = st.n_u, st.n_c, st.n_sc, st.n_y
     n_x = 5 * n_u + 2 * (n_c + n_sc) + 2
     y, p = ca.MX.sym("y", n_y), ca.MX.sym("p", 3 * n_u + 4)
@@ -316,6 +339,22 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     rhs = ca.MX.sym("rhs", n_y)
     solve = ca.Function("alpha_chunk_solve", [factor, rhs], [layout.solve(factor, rhs)])
 
+    # The step's predictor: (packed state, t0, h) -> (y, p)
+    xk, t0, h = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h")
+    parts = ca.vertsplit(xk, np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc, 1, 1]).tolist())
+    u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev, h_prev, _ = parts
+    c = coef
+    bh2 = c.beta * h * h
+    p_k = ca.vertcat(u + h * v + h * h * (0.5 - c.beta) * a, v + h * (1 - c.gamma) * a,
+                     (c.alpha_m * a - c.alpha_f * v_dot) / (1 - c.alpha_f), t0 + h, bh2, c.gamma * h,
+                     (1 - c.alpha_m) / (1 - c.alpha_f))
+    ratio = h / h_prev
+    y_k = ca.vertcat(p_k[:n_u] + bh2 * (a + ratio * (a - a_prev)), bh2 * (lam + ratio * (lam - lam_prev)),
+                     ca.MX(n_y - n_u - n_c - n_sc, 1), sc + ratio * (sc - sc_prev))
+    predictor = ca.Function("alpha_chunk_predictor", [xk, t0, h], [y_k, p_k])
+    # the matrix afresh at a step's predictor (run by the caller before a call that renews it)
+    renew_matrix = ca.Function("alpha_chunk_renew", [xk, t0, h], [factorize(y_k, p_k, ca.MX(layout.size, 1))])
+
     # One Newton iteration: (y, previous error, status, count, fresh) -> (y, error, status,
     # count); status 0 running, 1 converged, 2 failed, 3 slow (wants a fresh matrix): the
     # tests of solve_step. fresh: the matrix was factorized in this step. scale: the Newton
@@ -337,29 +376,19 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     iterate = ca.Function("alpha_chunk_iteration", args, [y + dy, err, new_status, count + 1])
     keep = ca.Function("alpha_chunk_keep", args, [y, prev, status, count])
     newton = ca.Function.if_else("alpha_chunk_newton", keep, iterate)
-
     # One step: (packed state, factor, renew, t0, h, index, n, scale) -> (state, factor,
-    # iterations, factorizations)
+    # iterations, factorizations); renew: the factor was made at this step's predictor
     xk, t0, h, index, n = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h"), ca.MX.sym("k"), ca.MX.sym("n")
-    # scale: the Newton tolerance of each unknown, then per round the contraction above which
-    # the iteration counts as slow
-    scale = ca.MX.sym("scale", n_y + ROUNDS)
+    scale = ca.MX.sym("scale", n_y + ROUNDS)  # then per round the contraction that is slow
     renew = ca.MX.sym("renew")
     parts = ca.vertsplit(xk, np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc, 1, 1]).tolist())
     u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev, h_prev, was_failed = parts
-    c = coef
-    bh2 = c.beta * h * h
-    p_k = ca.vertcat(u + h * v + h * h * (0.5 - c.beta) * a, v + h * (1 - c.gamma) * a,
-                     (c.alpha_m * a - c.alpha_f * v_dot) / (1 - c.alpha_f), t0 + h, bh2, c.gamma * h,
-                     (1 - c.alpha_m) / (1 - c.alpha_f))
-    ratio = h / h_prev
-    y_k = ca.vertcat(p_k[:n_u] + bh2 * (a + ratio * (a - a_prev)), bh2 * (lam + ratio * (lam - lam_prev)),
-                     ca.MX(n_y - n_u - n_c - n_sc, 1), sc + ratio * (sc - sc_prev))
+    bh2 = coef.beta * h * h
+    y_k, p_k = predictor(xk, t0, h)
     active = ca.logic_and(index < n, was_failed == 0)
-    wanted = ca.logic_and(active, renew)
-    f_k = refresh(wanted, y_k, p_k, factor)
-    fr, factorizations = wanted, wanted
+    fr = ca.logic_and(active, renew)
     e, stat, cnt = ca.MX(0), ca.if_else(active, 0, 1), ca.MX(0)  # an inactive step: "converged" untouched
+    f_k, factorizations = factor, ca.MX(0)
     for round_ in range(ROUNDS):
         round_scale = ca.vertcat(scale[:n_y], scale[n_y + round_])
         for _ in range(MAX_ITERATIONS // ROUNDS):
@@ -397,7 +426,7 @@ def _chunk_functions(st: StepEquations, coef) -> list:
             total += fk
         functions.append(ca.Function(f"alpha_chunk_{per}", [x0, times, h, n, factor, renew, scale],
                                      [x, f_out, ca.vertcat(*counts), total]))
-    return functions
+    return functions + [renew_matrix]
 
 
 def _layout(st: StepEquations, couplings: tuple | None = None) -> BorderedBand:

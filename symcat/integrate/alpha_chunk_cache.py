@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from collections import OrderedDict
 from functools import lru_cache
 from pathlib import Path
 
@@ -36,6 +37,10 @@ from ..codegen.paths import PACKAGE_DIR, atomic_write, cache_dir, generated_dir,
 
 #: Version of the record's content (a change makes older records unreadable, not wrong).
 RECORD_VERSION = 2
+#: Models whose per-model functions :func:`model_memo` keeps in a process (least recently used
+#: first out; a function of a small model is tens of kilobytes, with its maps a few hundred).
+MEMO_SIZE = 32
+_MEMO: OrderedDict = OrderedDict()
 
 
 @lru_cache(maxsize=None)
@@ -97,3 +102,27 @@ def write_record(key: str | None, library_key: str, mass_scale: float) -> None:
         return
     record = {"version": RECORD_VERSION, "key": key, "library": library_key, "mass_scale": float(mass_scale)}
     atomic_write(_record_path(key), json.dumps(record).encode())
+
+
+def model_memo(model, form, tag: tuple, build):
+    """``build()`` once per process for all models of one digest (:func:`model_key` of ``model``
+    and ``form`` with ``tag``, which names what is built and what else it follows from, e.g. the
+    element windows); every call when the model has no key.
+
+    Why: a run builds its model anew, and the functions a run needs besides the compiled steps
+    (the consistent initial state's terms, the results' post-processing terms and their maps
+    over the outputs) are built from it as CasADi graphs; on a small model that costs as much
+    as the compiled steps of a coarse run, although the digest says the graph would be the same
+    as the last run's. The values are kept, not copied: what ``build`` returns must not change
+    with use in a way that depends on the model (a cache of evaluations by size is fine)."""
+    key = model_key(model, form, ("memo",) + tuple(tag))
+    if key is None:
+        return build()
+    found = _MEMO.get(key)
+    if found is None:
+        found = _MEMO[key] = build()
+        while len(_MEMO) > MEMO_SIZE:
+            _MEMO.popitem(last=False)
+    else:
+        _MEMO.move_to_end(key)
+    return found

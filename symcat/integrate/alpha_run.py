@@ -56,8 +56,9 @@ class AlphaRun:
             if self.form.n_sc and len(self.contacts) >= n:  # no contacts evaluated over whole wires
                 given += (tuple(np.array([c[k] for c in self.contacts[:n]], float) for k in range(2)),)
         modes = self.modes[:n] if self.modes is not None else [()] * n
+        # a run whose steps were compiled has its terms compiled too (seconds once per model)
         res = collect_result(self.form, self.t_s[:n], self.xs, self.zs, self.stats, wall0, modes, self.events,
-                             self.walls, given)
+                             self.walls, given, compiled=self.stats.get("compiled_steps", 0) > 0)
         res.monitored = {key: np.asarray(values) for key, values in self.monitored.items()}
         return res
 

@@ -9,20 +9,21 @@ columns. Factorized as
     [B  E]   B = L U (band, no pivoting)
     [F  D]   S = D - F B^-1 E (dense, small: solved through its QR),
 
-the cost is O(n b^2) and every index is known when the code is generated: the straight-line
-code of the band has no sparse bookkeeping at run time. Without pivoting the band must not
+the cost is O(n b^2) and every index is known when the code is generated: the band's
+factorization and solves are C loops over its fixed layout (:mod:`symcat.codegen.band_c`), the
+border's gathers and products straight-line code, with no sparse bookkeeping at run time. Without pivoting the band must not
 need it: the wires' block of a generalized-alpha step is ``c_m M + gamma h D + beta h^2 K``
 plus small constraint terms, positive definite in practice; a zero or tiny pivot shows as a
 non-finite solution, which the caller treats as a failed step.
 """
 from __future__ import annotations
 
-from functools import lru_cache
-
 import casadi as ca
 import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+from ..codegen.band_c import band_functions, matvec
 
 
 class BorderedBand:
@@ -94,8 +95,7 @@ class BorderedBand:
         def gather(index):
             return values[index.ravel(order="F").tolist()]
 
-        present = self.band_from != self.nnz
-        lu = _band_lu(n_b, self.bw, present.tobytes())(gather(self.band_from)) if n_b else ca.MX(0, 1)
+        lu = band_functions(n_b, self.bw)[0](gather(self.band_from)) if n_b else ca.MX(0, 1)
         return self._with_border(lu, gather) if n_r else lu
 
     def refactorize_border(self, factor: ca.MX, nonzeros: ca.MX) -> ca.MX:
@@ -112,10 +112,11 @@ class BorderedBand:
         e = ca.reshape(gather(self.e_from), n_b, n_e)
         f = ca.reshape(gather(self.f_from), n_f, n_b)
         d = ca.reshape(gather(self.d_from), n_r, n_r)
-        x = _band_solve(n_b, self.bw).map(n_e)(lu, e) if n_b and n_e else ca.MX(n_b, n_e)
+        x = band_functions(n_b, self.bw)[1].map(n_e)(lu, e) if n_b and n_e else ca.MX(n_b, n_e)
         s = ca.MX(d)
         if n_e and n_f:
-            s[self.f_rows.tolist(), self.e_cols.tolist()] = s[self.f_rows.tolist(), self.e_cols.tolist()] - ca.mtimes(f, x)
+            fx = ca.reshape(matvec(n_f, n_b).map(n_e)(ca.vec(f), x), n_f, n_e) if n_b else ca.MX(n_f, n_e)
+            s[self.f_rows.tolist(), self.e_cols.tolist()] = s[self.f_rows.tolist(), self.e_cols.tolist()] - fx
         s_inv = ca.solve(s, ca.MX.eye(n_r), "qr")
         return ca.vertcat(lu, ca.vec(x), ca.vec(f), ca.vec(s_inv))
 
@@ -124,79 +125,21 @@ class BorderedBand:
         n_b, n_r, w = self.n_b, self.n_r, 2 * self.bw + 1
         lu = factor[: n_b * w]
         perm = self.perm.tolist()
-        z = _band_solve(n_b, self.bw)(lu, rhs[perm]) if n_b else ca.MX(0, 1)
+        z = band_functions(n_b, self.bw)[1](lu, rhs[perm]) if n_b else ca.MX(0, 1)
         if n_r:
             n_e, n_f = self.n_e, self.n_f
             at = n_b * w
-            x = ca.reshape(factor[at : at + n_b * n_e], n_b, n_e)
-            f = ca.reshape(factor[at + n_b * n_e : at + n_b * (n_e + n_f)], n_f, n_b)
+            x = factor[at : at + n_b * n_e]  # (n_b x n_e, column-major)
+            f = factor[at + n_b * n_e : at + n_b * (n_e + n_f)]  # (n_f x n_b)
             s_inv = ca.reshape(factor[at + n_b * (n_e + n_f) :], n_r, n_r)
             t = ca.MX(rhs[n_b:])
-            if n_f:
-                t[self.f_rows.tolist()] = t[self.f_rows.tolist()] - ca.mtimes(f, z)
+            if n_f and n_b:
+                t[self.f_rows.tolist()] = t[self.f_rows.tolist()] - matvec(n_f, n_b)(f, z)
             y_r = ca.mtimes(s_inv, t)
-            if n_e:
-                z = z - ca.mtimes(x, y_r[self.e_cols.tolist()])
+            if n_e and n_b:
+                z = z - matvec(n_b, n_e)(x, y_r[self.e_cols.tolist()])
         else:
             y_r = ca.MX(0, 1)
         back = np.empty(n_b, int)
         back[self.perm] = np.arange(n_b)
         return ca.vertcat(z[back.tolist()] if n_b else ca.MX(0, 1), y_r)
-
-
-@lru_cache(maxsize=8)
-def _band_lu(n: int, bw: int, present: bytes) -> ca.Function:
-    """``band -> lu``: the LU factors without pivoting of a band matrix (row-major band storage,
-    ``a[i, j]`` at ``i (2 bw + 1) + j - i + bw``; ``present``, the bytes of a boolean array,
-    marks the entries that can be nonzero; one function per layout, so that code made of it
-    holds it once), ``L`` unit lower below the diagonal and ``U`` on and above it, in the same
-    storage; straight-line scalar code (structural zeros and their fill-in followed)."""
-    w = 2 * bw + 1
-    present = np.frombuffer(present, dtype=bool)
-    band = ca.SX.sym("band", n * w)
-    a = {}
-    for i in range(n):
-        for j in range(max(0, i - bw), min(n, i + bw + 1)):
-            k = i * w + j - i + bw
-            a[(i, j)] = band[k] if present[k] else ca.SX(0)
-    for k in range(n):
-        inv = 1 / a[(k, k)]
-        for i in range(k + 1, min(n, k + bw + 1)):
-            if ca.SX(a[(i, k)]).is_zero():
-                continue
-            lik = a[(i, k)] * inv
-            a[(i, k)] = lik
-            for j in range(k + 1, min(n, k + bw + 1)):
-                if not ca.SX(a[(k, j)]).is_zero():
-                    a[(i, j)] = a[(i, j)] - lik * a[(k, j)]
-    out = []
-    for i in range(n):
-        for j in range(i - bw, i + bw + 1):
-            out.append(a[(i, j)] if 0 <= j < n else ca.SX(0))
-    return ca.Function("band_lu", [band], [ca.vertcat(*out)])
-
-
-@lru_cache(maxsize=8)
-def _band_solve(n: int, bw: int) -> ca.Function:
-    """``(lu, b) -> x`` with the factors of :func:`_band_lu`; straight-line scalar code (one
-    function per size)."""
-    w = 2 * bw + 1
-    lu = ca.SX.sym("lu", n * w)
-    b = ca.SX.sym("b", n)
-
-    def at(i, j):
-        return lu[i * w + j - i + bw]
-
-    z = []
-    for i in range(n):  # L z = b
-        acc = b[i]
-        for j in range(max(0, i - bw), i):
-            acc -= at(i, j) * z[j]
-        z.append(acc)
-    x = [None] * n
-    for i in range(n - 1, -1, -1):  # U x = z
-        acc = z[i]
-        for j in range(i + 1, min(n, i + bw + 1)):
-            acc -= at(i, j) * x[j]
-        x[i] = acc / at(i, i)
-    return ca.Function("band_solve", [lu, b], [ca.vertcat(*x)])

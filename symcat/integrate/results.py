@@ -13,9 +13,9 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from ..assembly.wheelrail import GAP_ROW
-from ..codegen.library import BufferedFunction
 from ..dae.formulation import Formulation, normal_forces_numeric
 from ..dae.initial import KKTPattern, settle_creep
+from .post_terms import Mapped, mapped_terms
 
 @dataclass
 class SimulationResult:
@@ -103,7 +103,7 @@ class SimulationResult:
 
 
 def collect_result(form: Formulation, t, xs, zs, stats, wall0, opens, events, walls=None,
-                   given=None) -> SimulationResult:
+                   given=None, compiled: bool = False) -> SimulationResult:
     """The :class:`SimulationResult` of the outputs ``xs``, ``zs`` at times ``t``.
 
     ``given = (accelerations, multipliers[, contacts])`` (free internal coordinates, (n, n_f) and
@@ -118,7 +118,7 @@ def collect_result(form: Formulation, t, xs, zs, stats, wall0, opens, events, wa
     for sl in model.windowed():
         sl.window = (0, len(sl.element_start) - 1)
     try:
-        res = _collect(form, t, xs, zs, stats, wall0, opens, events, given)
+        res = _collect(form, t, xs, zs, stats, wall0, opens, events, given, compiled)
         if walls is not None:
             res.output_wall_s = np.asarray(walls[: len(res.t_s)], float)
         return res
@@ -131,13 +131,14 @@ def collect_result(form: Formulation, t, xs, zs, stats, wall0, opens, events, wa
 CHUNK = 256
 
 
-def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events, given=None) -> SimulationResult:
+def _collect(form: Formulation, t, xs, zs, stats, wall0, opens, events, given=None,
+             compiled: bool = False) -> SimulationResult:
     model = form.model
     state = _stacked_state(form, xs, zs)
     n_t = state["q"].shape[0]
     q, v = _physical(form, state["q"], model.q0), _physical(form, state["v"], np.zeros(model.n_q))
     given_contacts = given[2] if given is not None and len(given) > 2 else None
-    post = _PostTerms(form, light=given is not None, contacts=given_contacts is None)
+    post = _PostTerms(form, light=given is not None, contacts=given_contacts is None, compiled=compiled)
     n_w = len(model.wheelrail)
     gaps, contact_forces = np.zeros((n_t, form.n_sc)), np.zeros((n_t, form.n_sc))
     acc = np.zeros_like(q)
@@ -244,49 +245,21 @@ def _wheel_gaps(model, q: np.ndarray, s: np.ndarray, c: np.ndarray) -> np.ndarra
     return gaps
 
 
-class _Mapped:
-    """A CasADi function of column vectors evaluated for many inputs in one call
-    (``Function.map``, built once per batch size): inputs and outputs with one row per
-    evaluation."""
-
-    def __init__(self, fn: ca.Function):
-        self.fn, self._maps = fn, {}
-        self._sizes = [fn.sparsity_out(i).numel() for i in range(fn.n_out())]
-        if any(fn.sparsity_out(i).size2() != 1 and size for i, size in enumerate(self._sizes)):
-            raise ValueError(f"{fn.name()}: the outputs must be column vectors to be mapped row-wise")
-        # The mapped outputs' nonzeros are each evaluation's in turn: per output, the rows
-        # its nonzeros fill.
-        self._rows = [np.array(fn.sparsity_out(i).row(), int) for i in range(fn.n_out())]
-
-    def __call__(self, *rows) -> list[np.ndarray]:
-        n = rows[0].shape[0]
-        if n not in self._maps:
-            self._maps[n] = BufferedFunction(self.fn.map(n))
-        # The mapped inputs are (size, n), column-major: the rows' own row-major order.
-        out = self._maps[n].nonzeros(*(np.asarray(r, float).reshape(n, -1).ravel() for r in rows))
-        dense = []
-        for nz, size, where in zip(out, self._sizes, self._rows):
-            d = np.zeros((n, size))
-            d[:, where] = nz.reshape(n, where.size)
-            dense.append(d)
-        return dense
-
-
 class _PostTerms:
     """The per-output terms of a formulation (constraints, drifts, mass matrix, forces, energies;
     sparse matrices as their nonzeros) and what follows from them: multipliers, accelerations,
     creep records and joint reactions. The sparsity patterns are the same at every output, so
     the KKT matrices and reactions are assembled by index maps built once."""
 
-    def __init__(self, form: Formulation, light: bool = False, contacts: bool = True):
+    def __init__(self, form: Formulation, light: bool = False, contacts: bool = True, compiled: bool = False):
         from ..assembly.wheelrail import has_creep
 
         self.form = form
         model = form.model
-        fn, self.patterns = _terms_function(form, light, contacts)
-        self._terms, self._names = _Mapped(fn), fn.name_out()
-        self.creep = _Mapped(form.creep_function()) if has_creep(model) else None
-        self._normal = _Mapped(form.normal_direction_function()) if model.wheelrail else None
+        fn, self.patterns, self._terms = mapped_terms(form, light, contacts, compiled)
+        self._names = fn.name_out()
+        self.creep = Mapped(form.creep_function()) if has_creep(model) else None
+        self._normal = Mapped(form.normal_direction_function()) if model.wheelrail else None
         self.normal_rows = form.normal_force_rows(full=True)  # the KKT multipliers have every row
         self._kkt = {}  # open rows -> KKTPattern
         self.reactions = _ReactionMap(model, self.patterns["Cq"])
@@ -339,37 +312,6 @@ class _PostTerms:
         colind, row = (np.asarray(x) for x in self.patterns["M"].get_ccs())
         return [spla.spsolve(sps.csc_matrix((m_nz, row, colind), shape=(n_f, n_f)), f)
                 for m_nz, f in zip(terms["M"], terms["Q"])]
-
-
-def _terms_function(form: Formulation, light: bool = False, contacts: bool = True) -> tuple[ca.Function, dict]:
-    """One output's terms as a function of ``(q, v, s, w, t, sc)``: ``C``, its rate ``C_dot``,
-    ``s_dot``, the nonzeros of ``Cq``, ``Cs`` and ``M``, ``Q``, ``Qd``, contact ``gap`` and ``fc``,
-    ``kinetic`` and ``potential`` energy; and the patterns of the sparse matrices. ``light``:
-    without ``M``, ``Q`` and ``Qd`` (the KKT system's, not solved when the integrator's
-    multipliers are given). ``contacts=False`` (light only): without the penalty contacts'
-    terms, whose values the integrator gave."""
-    if not (light or contacts):
-        raise ValueError("_terms_function: contacts=False needs light=True (the KKT forces include the contacts)")
-    model = form.model
-    n_f, n_s = form.n_f, form.n_s
-    qs, vs = ca.MX.sym("q", n_f), ca.MX.sym("v", n_f)
-    ss, ws, ts = ca.MX.sym("s", n_s), ca.MX.sym("w", n_s), ca.MX.sym("t")
-    scs = ca.MX.sym("sc", form.n_sc)
-    if form.formulation == "embedded" and n_s:
-        s_dot = form.embedded_terms(qs, vs, ss, ts, scs)["s_dot"]
-    else:
-        s_dot = ws
-    kk = form.terms(qs, vs, ss, s_dot, ts, scs, contacts=contacts)
-    qf = form.q_fixed + ca.mtimes(form.P, qs)
-    vf = ca.mtimes(form.P, vs)
-    sparse = {"Cq": kk["Cq"], "Cs": kk["Cs"]} if light else {"Cq": kk["Cq"], "Cs": kk["Cs"], "M": kk["M"]}
-    kkt = {} if light else {"Q": kk["Q"], "Qd": kk["Qd"]}
-    outs = {"C": kk["C"], "C_dot": ca.mtimes(kk["Cq"], vs) + ca.mtimes(kk["Cs"], s_dot) + kk["Ct"], "s_dot": s_dot,
-            **{name: ca.vec(x.nz[:]) for name, x in sparse.items()}, **kkt, "gap": kk["gap"],
-            "fc": kk["fc"], "kinetic": model.kinetic_energy(qf, vf), "potential": model.potential_energy(qf)}
-    fn = ca.Function("post", [qs, vs, ss, ws, ts, scs], list(outs.values()),
-                     ["q", "v", "s", "w", "t", "sc"], list(outs))
-    return fn, {name: x.sparsity() for name, x in sparse.items()}
 
 
 class _ReactionMap:

@@ -1,0 +1,206 @@
+"""The LU factorization without pivoting of a band matrix and its solve as C loops, for the
+compiled generalized-alpha steps (:mod:`symcat.integrate.bordered_band`).
+
+Why: as CasADi SX graphs both are straight-line code, one instruction per operation: for a
+wire of 60 cable elements (360 unknowns, half-bandwidth 11) 1.5 MB of machine code for the
+factorization and 250 kB for a solve, which with the wires' residual (700 kB) no longer fit
+the processor's caches: each Newton iteration streams its code from memory. As loops they are
+a few hundred bytes and do the same operations in the same order (the same results, bit for
+bit: a structurally zero entry that the graph leaves out is a zero here, and subtracting a
+product with a zero changes nothing).
+
+The functions are external to CasADi: :func:`band_functions` compiles them into a small
+library of their own (cached, for graphs evaluated in Python) and gives their C source, which
+code generated from a graph that calls them must include (:func:`source`): CasADi's generated
+code declares and calls them by name.
+"""
+from __future__ import annotations
+
+import os
+import re
+from functools import lru_cache
+from pathlib import Path
+
+import casadi as ca
+
+from .library import build_library, cached_library, find_compiler
+
+#: Flags of the kernels' own library (the code generated around them has its own).
+FLAGS = ("-O2", "-fPIC", "-shared")
+
+_TEMPLATE = r"""
+/* symcat band kernels: n = {n}, half-bandwidth {bw} (symcat.codegen.band_c) */
+#ifndef casadi_real
+#define casadi_real double
+#endif
+#ifndef casadi_int
+#define casadi_int long long int
+#endif
+static const casadi_int {lu}_sp[] = {{{size}, 1, 1}};  /* dense (CasADi's compact form) */
+static const casadi_int {solve}_sp[] = {{{n}, 1, 1}};
+
+/* band -> lu: row-major band storage, a[i][j] at i (2 bw + 1) + j - i + bw; L unit lower
+   below the diagonal, U on and above it */
+int {lu}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
+  const casadi_int n = {n}, bw = {bw}, wd = 2 * {bw} + 1;
+  casadi_int i, j, k, end;
+  casadi_real *a = res[0], inv, lik;
+  if (!a) return 0;
+  for (i = 0; i < n * wd; ++i) a[i] = arg[0] ? arg[0][i] : 0;
+  for (k = 0; k < n; ++k) {{
+    inv = 1 / a[k * wd + bw];
+    end = k + bw + 1 < n ? k + bw + 1 : n;
+    for (i = k + 1; i < end; ++i) {{
+      lik = a[i * wd + k - i + bw] * inv;
+      a[i * wd + k - i + bw] = lik;
+      for (j = k + 1; j < end; ++j) a[i * wd + j - i + bw] -= lik * a[k * wd + j - k + bw];
+    }}
+  }}
+  return 0;
+}}
+
+/* (lu, b) -> x: L z = b, then U x = z, by columns: each unknown once known is taken out of
+   the next bw equations (independent updates, where the rows' sums would be a chain of
+   dependent ones); a[i][j] at lu[i (wd - 1) + j + bw] */
+int {solve}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
+  const casadi_int n = {n}, bw = {bw}, wd = 2 * {bw} + 1;
+  casadi_int i, j, end;
+  const casadi_real *restrict lu = arg[0], *restrict b = arg[1];
+  casadi_real *restrict x = res[0], xj;
+  if (!x) return 0;
+  for (i = 0; i < n; ++i) x[i] = b ? b[i] : 0;
+  for (j = 0; j < n; ++j) {{
+    xj = x[j];
+    end = j + bw + 1 < n ? j + bw + 1 : n;
+    for (i = j + 1; i < end; ++i) x[i] -= lu[i * (wd - 1) + j + bw] * xj;
+  }}
+  for (j = n - 1; j >= 0; --j) {{
+    xj = x[j] /= lu[j * (wd - 1) + j + bw];
+    for (i = j - bw > 0 ? j - bw : 0; i < j; ++i) x[i] -= lu[i * (wd - 1) + j + bw] * xj;
+  }}
+  return 0;
+}}
+
+casadi_int {lu}_n_in(void) {{ return 1; }}
+casadi_int {lu}_n_out(void) {{ return 1; }}
+const casadi_int* {lu}_sparsity_in(casadi_int i) {{ return {lu}_sp; }}
+const casadi_int* {lu}_sparsity_out(casadi_int i) {{ return {lu}_sp; }}
+casadi_int {solve}_n_in(void) {{ return 2; }}
+casadi_int {solve}_n_out(void) {{ return 1; }}
+const casadi_int* {solve}_sparsity_in(casadi_int i) {{ return i == 0 ? {lu}_sp : {solve}_sp; }}
+const casadi_int* {solve}_sparsity_out(casadi_int i) {{ return {solve}_sp; }}
+"""
+
+
+_MATVEC = r"""
+/* symcat dense product: y = A x, A {m} x {n} column-major (symcat.codegen.band_c) */
+#ifndef casadi_real
+#define casadi_real double
+#endif
+#ifndef casadi_int
+#define casadi_int long long int
+#endif
+static const casadi_int {name}_sp[3][3] = {{{{{size}, 1, 1}}, {{{n}, 1, 1}}, {{{m}, 1, 1}}}};
+
+int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
+  casadi_int j, k;
+  const casadi_real *restrict a = arg[0], *restrict x = arg[1];
+  casadi_real *restrict y = res[0], acc[{m}], xk;
+  if (!y) return 0;
+  for (j = 0; j < {m}; ++j) acc[j] = 0;
+  if (a && x) {{
+    for (k = 0; k < {n}; ++k) {{
+      xk = x[k];
+      for (j = 0; j < {m}; ++j) acc[j] += a[j + k * {m}] * xk;
+    }}
+  }}
+  for (j = 0; j < {m}; ++j) y[j] = acc[j];
+  return 0;
+}}
+
+casadi_int {name}_n_in(void) {{ return 2; }}
+casadi_int {name}_n_out(void) {{ return 1; }}
+const casadi_int* {name}_sparsity_in(casadi_int i) {{ return {name}_sp[i]; }}
+const casadi_int* {name}_sparsity_out(casadi_int i) {{ return {name}_sp[2]; }}
+"""
+
+
+def names(n: int, bw: int) -> tuple[str, str]:
+    """The C names of the factorization and the solve for ``n`` unknowns, half-bandwidth ``bw``."""
+    return f"symcat_band_lu_{n}_{bw}", f"symcat_band_solve_{n}_{bw}"
+
+
+def source(n: int, bw: int) -> str:
+    """The C source of both functions (to be included in code generated from a graph that
+    calls them)."""
+    lu, solve = names(n, bw)
+    size = n * (2 * bw + 1)
+    return _TEMPLATE.format(n=n, bw=bw, lu=lu, solve=solve, size=size)
+
+
+@lru_cache(maxsize=8)
+def band_functions(n: int, bw: int) -> tuple[ca.Function, ca.Function]:
+    """``(lu, solve)``: ``band -> lu`` and ``(lu, b) -> x`` as CasADi externals of their own
+    compiled library (cached on disk under the source's digest)."""
+    lu, solve = names(n, bw)
+    target = _library(source(n, bw))
+    return ca.external(lu, str(target)), ca.external(solve, str(target))
+
+
+def matvec_source(m: int, n: int) -> str:
+    """The C source of ``symcat_matvec_<m>_<n>``: ``(A, x) -> A x``."""
+    return _MATVEC.format(name=f"symcat_matvec_{m}_{n}", m=m, n=n, size=m * n)
+
+
+@lru_cache(maxsize=32)
+def matvec(m: int, n: int) -> ca.Function:
+    """``(A, x) -> A x`` for a dense ``m x n`` matrix ``A`` given by its column-major entries,
+    as a CasADi external: the sums in CasADi's order (each row's over the columns in turn),
+    in registers. CasADi's generated product accumulates through memory (``z[j] += ...``,
+    whose store and reload set its speed: six microseconds for the 360 x 10 and 11 x 360
+    products of a step's solve on the moving load, as long as the band's solve)."""
+    return ca.external(f"symcat_matvec_{m}_{n}", str(_library(matvec_source(m, n))))
+
+
+def _library(text: str) -> Path:
+    """The compiled library of the C ``text`` (cached under its digest)."""
+    target = cached_library("band", text.encode(), FLAGS)
+    if not target.exists():
+        c_path = target.with_name(f".{target.stem}-{os.getpid()}.c")
+        c_path.parent.mkdir(parents=True, exist_ok=True)
+        c_path.write_text(text)
+        try:
+            build_library(find_compiler(), FLAGS, c_path, target)
+        finally:
+            c_path.unlink(missing_ok=True)
+    return target
+
+
+#: CasADi's copy loop (``casadi_copy``), one element at a time, and what replaces it.
+_COPY_LOOP = "for (i=0; i<n; ++i) *y++ = *x++;"
+_COPY = "memmove(y, x, n * sizeof(casadi_real));"
+#: CasADi's ``casadi_fmax`` calls the C library's ``fmax`` (not inlined without -ffast-math:
+#: a call per use, a few hundred in a step's code); the same result inline: the other argument
+#: when one is NaN.
+_FMAX = "  return fmax(x, y);"
+_FMAX_INLINE = "  return (x > y || y != y) ? x : y;"
+
+
+def include_in(c_path: Path) -> Path:
+    """Append to the generated ``c_path`` the source of every kernel of this module it calls
+    (CasADi's code declares and calls them by name), and make its copies ``memmove``: CasADi's
+    ``casadi_copy`` loop moves one number per instruction, and the compiled steps copy their
+    factor (16k numbers on the moving load) three times a step; the C library's copy is
+    several times faster. ``casadi_fmax`` is made inline (:data:`_FMAX`). Nothing else of the
+    generated code changes."""
+    text = c_path.read_text()
+    if _COPY_LOOP in text:
+        text = "#include <string.h>\n" + text.replace(_COPY_LOOP, _COPY)
+    text = text.replace(_FMAX, _FMAX_INLINE)
+    parts = [text]
+    for n, bw in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_band_(?:lu|solve)_(\d+)_(\d+)\(", text)}):
+        parts.append(source(n, bw))
+    for m, n in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_matvec_(\d+)_(\d+)\(", text)}):
+        parts.append(matvec_source(m, n))
+    c_path.write_text("".join(parts))
+    return c_path
