@@ -17,7 +17,7 @@ from ..scene.joints import unit
 
 def add_contact(model, contact: PenaltyContact):
     """Record of one contact for ``model`` (a :class:`MultibodyModel` under construction)."""
-    from .multibody import Sliding, wire_attachment
+    from .wire_attachment import Sliding, wire_attachment
 
     wire, body, starts = wire_attachment(model.scene, "contact", contact.name, contact.wire, contact.body, contact.s0)
     library = f"contact_{wire.element.name}_rigid"

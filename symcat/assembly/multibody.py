@@ -23,13 +23,12 @@ import numpy as np
 from ..codegen.fingerprint import scene_digest
 from ..codegen.library import kernel_library, library_interface
 from ..errors import ParameterError
-from ..scene.ancf import AncfBody
 from ..scene.joints import Driving, Fixed, Prismatic, Revolute, SlidingJoint, Spherical, perpendiculars, unit
-from ..scene.rigid import RigidBody
 from ..scene.wheelrail import WheelRailJoint
 from ..scene.scene import Scene
 from .sparse import MatrixScatter, to_casadi_sparse, vector_scatter
 from .system import System
+from .wire_attachment import Sliding, wire_attachment
 from .windows import ElementWindows
 from ..wheelrail.identity_memo import IdentityMemo
 
@@ -52,37 +51,6 @@ class KernelGroup:
     rows: list = field(default_factory=list)      # per instance: global indices of y
     params: list = field(default_factory=list)    # per instance: parameter vector
     names: list = field(default_factory=list)     # per instance: joint/force name
-
-
-@dataclass
-class Sliding:
-    joint: SlidingJoint
-    wire: AncfBody
-    body: RigidBody
-    library: str
-    s_index: int
-    element_start: np.ndarray      # arc length at the start of each element (m)
-    element_indices: np.ndarray    # (n_el, n_loc) global coordinate indices
-    params: np.ndarray
-    window: tuple[int, int] = (0, 0)
-
-
-def wire_attachment(scene, kind: str, name: str, wire_name: str, body_name: str, s0: float):
-    """Check a rigid body attached to an ANCF wire at arc length ``s0`` (sliding joint or
-    contact); returns the wire, the body and the arc length at each element start (m)."""
-    wire = scene.find(wire_name)
-    body = scene.find(body_name)
-    if not isinstance(body, RigidBody):
-        raise ParameterError(f"{kind} {name!r}: body={body_name!r} must be a rigid body")
-    if wire.element.name not in ("cable3d", "beam3d"):
-        raise ParameterError(f"{kind} {name!r}: wire {wire.name!r} is {wire.element.name}; a {kind} needs cable3d or beam3d")
-    starts = np.concatenate([[0.0], np.cumsum(wire.params[:, 0])])
-    if kind == "contact":  # a contact may start on the wire's straight continuation past an end
-        if not np.isfinite(s0):
-            raise ParameterError(f"{kind} {name!r}: s0={s0!r} m must be a finite arc length")
-    elif not 0 <= s0 <= starts[-1]:
-        raise ParameterError(f"{kind} {name!r}: s0={s0:g} m must lie on the wire, in [0, {starts[-1]:g}] m")
-    return wire, body, starts
 
 
 class MultibodyModel(ElementWindows):

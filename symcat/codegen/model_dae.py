@@ -78,12 +78,10 @@ def compiled_library(name: str, key: bytes, write_c: Callable[[Path], Path], mod
     first and optimized (``optimized_flags``) in the background, or optimized now, or -O0 only
     (``mode``, default ``$SYMCAT_OPTIMIZE``, :mod:`.optimized`). ``build=False``: only a
     library already cached (``None`` if there is none)."""
-    mode = optimize_mode() if mode is None else mode
-    plain = cached_library(name, key, FLAGS)
-    optimized = cached_library(name, key, optimized_flags)
+    mode, plain, optimized, target = _tiers(name, key, mode, optimized_flags)
     if mode != "off" and optimized.exists():
         return optimized
-    target, flags = (optimized, optimized_flags) if mode == "now" else (plain, FLAGS)
+    flags = optimized_flags if target == optimized else FLAGS
     if not build:
         return target if target.exists() else plain if plain.exists() else None
     if not target.exists():
@@ -110,17 +108,24 @@ def existing_library(name: str, key: bytes, mode: str | None = None,
     """What :func:`compiled_library` with these arguments would return if that needs no
     compiler now (the library it picks is cached; the optimized tier's background compiler is
     started as it would start it), else None."""
-    mode = optimize_mode() if mode is None else mode
-    plain = cached_library(name, key, FLAGS)
-    optimized = cached_library(name, key, optimized_flags)
+    mode, plain, optimized, target = _tiers(name, key, mode, optimized_flags)
     if mode != "off" and optimized.exists():
         return optimized
-    target = optimized if mode == "now" else plain
     if not target.exists():
         return None
     if mode == "background" and source_path(optimized).exists():
         start_background(optimized, optimized_flags)
     return target
+
+
+def _tiers(name: str, key: bytes, mode: str | None, optimized_flags: tuple) -> tuple[str, Path, Path, Path]:
+    """``(mode, plain, optimized, target)``: the optimization mode (default ``$SYMCAT_OPTIMIZE``),
+    the -O0 and optimized libraries' cache paths, and the one a run compiles when neither is
+    there (the optimized one in mode ``now``)."""
+    mode = optimize_mode() if mode is None else mode
+    plain = cached_library(name, key, FLAGS)
+    optimized = cached_library(name, key, optimized_flags)
+    return mode, plain, optimized, optimized if mode == "now" else plain
 
 
 @contextmanager

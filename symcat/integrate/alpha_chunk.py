@@ -48,7 +48,7 @@ from .alpha_chunk_cache import model_key, read_record, write_record
 from .alpha_chunk_residual import ChunkResidual
 from .alpha_integrator import Integrator, State
 from .alpha_newton import SLOW_CONTRACTION
-from .alpha_step import StepEquations
+from .alpha_step import StepEquations, step_sizes
 from .bordered_band import BorderedBand
 
 log = logging.getLogger(__name__)
@@ -186,7 +186,7 @@ class CompiledSteps:
         # the factor in two arrays the calls take turns to read and write (no copies, _call)
         size = self._fns[LENGTHS[0]].function.nnz_in(4)
         self._factors = (np.zeros(size), np.zeros(size))
-        self._cuts = np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc]).tolist()
+        self._cuts = _packed_cuts(n_u, n_c, n_sc)[:-2]
         self._mass_scale = mass_scale
         model = self.integ.model
         border = n_y > np.count_nonzero(model.free < model.ancf.n)  # unknowns besides the wires'
@@ -232,10 +232,10 @@ class CompiledSteps:
         return State(u, v, v_dot, a, lam, sc, (a_prev, lam_prev, sc_prev), float(x[cuts[-1]])), x
 
 
-def step_sizes(form, variant: str) -> tuple[int, int, int, int]:
-    """``(n_u, n_c, n_sc, n_y)`` of the steps of ``form`` (as :class:`StepEquations` has them)."""
-    n_u = form.n_f + form.n_s
-    return n_u, form.n_c, form.n_sc, n_u + form.n_c * (2 if variant == "stabilized" else 1) + form.n_sc
+def _packed_cuts(n_u: int, n_c: int, n_sc: int) -> list[int]:
+    """Where the packed state's parts start: ``u v v_dot a lam sc a_prev lam_prev sc_prev``,
+    then ``h`` and the failed flag (one entry each)."""
+    return np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc, 1, 1]).tolist()
 
 
 def _settings(variant: str, coef) -> tuple:
@@ -341,7 +341,7 @@ def _chunk_functions(st: StepEquations, coef) -> list:
 
     # The step's predictor: (packed state, t0, h) -> (y, p)
     xk, t0, h = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h")
-    parts = ca.vertsplit(xk, np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc, 1, 1]).tolist())
+    parts = ca.vertsplit(xk, _packed_cuts(n_u, n_c, n_sc))
     u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev, h_prev, _ = parts
     c = coef
     bh2 = c.beta * h * h
@@ -381,7 +381,7 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     xk, t0, h, index, n = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h"), ca.MX.sym("k"), ca.MX.sym("n")
     scale = ca.MX.sym("scale", n_y + ROUNDS)  # then per round the contraction that is slow
     renew = ca.MX.sym("renew")
-    parts = ca.vertsplit(xk, np.cumsum([0, n_u, n_u, n_u, n_u, n_c, n_sc, n_u, n_c, n_sc, 1, 1]).tolist())
+    parts = ca.vertsplit(xk, _packed_cuts(n_u, n_c, n_sc))
     u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev, h_prev, was_failed = parts
     bh2 = coef.beta * h * h
     y_k, p_k = predictor(xk, t0, h)

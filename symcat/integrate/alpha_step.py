@@ -48,6 +48,14 @@ from .alpha_proxies import Proxies
 from .alpha_rest import compiled_rest, expanded_rest
 
 
+def step_sizes(form: Formulation, variant: str) -> tuple[int, int, int, int]:
+    """``(n_u, n_c, n_sc, n_y)`` of the steps of ``form`` under ``variant``: the coordinates and
+    arc lengths, the constraints, the penalty contacts' arc lengths and the unknowns ``y``
+    (:class:`StepEquations`), known without building the equations."""
+    n_u = form.n_f + form.n_s
+    return n_u, form.n_c, form.n_sc, n_u + form.n_c * (2 if variant == "stabilized" else 1) + form.n_sc
+
+
 class StepEquations:
     """The step equations of one element window: the rest's residual and exact Jacobian (one
     expanded function), with the window-independent :class:`Bulk` (carried over from the
@@ -67,10 +75,8 @@ class StepEquations:
     def __init__(self, form: Formulation, variant: str, expand: bool = False, bulk: Bulk | None = None,
                  mass_scale: float | None = None, proxies: bool = True,
                  compiled: bool | None = True):
-        n_f, n_s, n_c, n_sc = form.n_f, form.n_s, form.n_c, form.n_sc
-        self.n_u, self.n_c, self.n_s, self.n_sc = n_f + n_s, n_c, n_s, n_sc
-        n_u = self.n_u
-        self.n_y = n_y = n_u + n_c * (2 if variant == "stabilized" else 1) + n_sc
+        n_u, n_c, n_sc, n_y = step_sizes(form, variant)
+        self.n_u, self.n_c, self.n_s, self.n_sc, self.n_y = n_u, n_c, form.n_s, n_sc, n_y
         self.variant, self.form = variant, form
         model = form.model
         # Few wire unknowns against the rest (the seed's 8-element wire under a vehicle, or no
