@@ -30,12 +30,18 @@ class ScenePantograph:
         Shown in plot titles and the summary.
     description : str
         One line about the model (plot titles).
+    placed : bool
+        Whether ``add`` places the pantograph in its static equilibrium on the wire loaded by
+        the static contact force: the static solve then starts as Newton's method (two
+        iterations) instead of a pseudo-transient continuation from rest (ten), which a
+        linkage placed by its geometry alone needs.
     """
 
     add: PantographFragment
     uplift: float = 100.0
     name: str = "pantograph"
     description: str = ""
+    placed: bool = False
 
 
 def seo2005_fragment(contact: str = "penalty", contact_stiffness: float = 5.0e4, contact_damping: float = 0.0,
@@ -100,7 +106,7 @@ def lumped_fragment(pantograph, contact: str = "penalty", contact_stiffness: flo
         return info["contact"]
 
     return ScenePantograph(add, uplift=float(pantograph.uplift), name=f"{pantograph.name} (scene)",
-                           description=f"{pantograph.name} as scene bodies")
+                           description=f"{pantograph.name} as scene bodies", placed=form is not None)
 
 
 def contact_element(scene, name: str):
@@ -166,12 +172,18 @@ def add_section_contacts(form: FormFindingResult, scene, element, x0: float) -> 
     return copies
 
 
-def _static(form, pantographs, wire: str, positions, speed: float, uplifts, wires: str = "nonlinear"):
+def _static(form, pantographs, wire: str, positions, speed: float, uplifts, wires: str = "nonlinear",
+            load: float | None = None):
     """Scene, model, contact elements and equilibrium of the ``pantographs`` at ``positions``
-    (m) with ``uplifts`` (N) under the catenary with ``wires`` (:func:`catenary_scene`)."""
+    (m) with ``uplifts`` (N) under the catenary with ``wires`` (:func:`catenary_scene`). The
+    solve starts with the wires in the catenary's static state under ``load`` (N, the
+    expected contact force) at each pantograph (:func:`~symcat.pantograph.lumped_scene.
+    loaded_catenary`): from the unloaded wires it would first have to lift them by the
+    pantographs' uplift, several times the iterations."""
     from ..analysis.equilibrium import solve_equilibrium
     from ..assembly.multibody import MultibodyModel
     from ..catenary.scene import catenary_scene
+    from ..pantograph.lumped_scene import loaded_catenary
 
     from ..scene import PenaltyContact
 
@@ -189,7 +201,11 @@ def _static(form, pantographs, wire: str, positions, speed: float, uplifts, wire
             add_section_contacts(form, scene, element, x0)
         elements.append(element)
     model = MultibodyModel(scene)
-    eq = solve_equilibrium(model)
+    if load is not None:  # the structure's coordinates lead the scene's (catenary_scene)
+        model.q0[: form.structure.n] = loaded_catenary(form, positions, [load] * len(positions))
+    # A pantograph placed in equilibrium on the loaded wires needs no pseudo-inertia (h of 1 s).
+    eq = solve_equilibrium(model, pseudo_time_step=1.0 if load is not None and all(p.placed for p in pantographs)
+                           else 1e-2)
     return scene, model, elements, eq
 
 
@@ -218,12 +234,12 @@ def trim_uplifts(form, pantographs, target_force: float, wire: str, positions, s
         return np.abs(f - target_force).max() <= force_rtol * abs(target_force)
 
     u0 = np.array([float(p.uplift) for p in pantographs])
-    built = _static(form, pantographs, wire, positions, speed, u0, wires)
+    built = _static(form, pantographs, wire, positions, speed, u0, wires, target_force)
     f0 = np.array([static_force(built[3], e) for e in built[2]])
     solves = 1
     u1 = u0 + (target_force - f0)  # unit sensitivity as the first guess (uplift at the pan-head)
     while solves < max_solves and not done(f0):
-        built1 = _static(form, pantographs, wire, positions, speed, u1, wires)
+        built1 = _static(form, pantographs, wire, positions, speed, u1, wires, target_force)
         f1 = np.array([static_force(built1[3], e) for e in built1[2]])
         solves += 1
         if not np.all((f1 > 0) | (f0 > 0)):

@@ -233,6 +233,7 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
     positions = [x_trail + spacing * (n_p - 1 - k) for k in range(n_p)]  # leading first
     if form is None:
         form = find_form(design, elements_per_span, element, progress=progress)
+    placed0 = time.perf_counter()  # the passage's wall: static placement and integration, as run_passage's
     if progress:
         notice(f"trimming the uplift of the {pantographs[0].name} pantograph{'s' if n_p > 1 else ''} to a static "
                f"contact force of {target_force:g} N (static solves of the joint equilibrium)")
@@ -271,6 +272,7 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
                             multipliers="integrator", monitor=monitor)  # no KKT solve per output
     rec = SceneRecord(record_histories(res, form, model, elements, record_every, energy), form, speed,
                       dict(res.stats))
+    rec.stats["passage_wall_s"] = time.perf_counter() - placed0
     rec.uplift_N, rec.static_contact_force_N = out.uplift_N, out.static_contact_force_N
     line._record = rec
     stats = [pantograph_statistics(rec.t_s, rec.x_contact_m[:, k], rec.contact_force_N[:, k], section,

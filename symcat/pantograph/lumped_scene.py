@@ -118,20 +118,44 @@ def wire_height(scene: Scene, wire: str, x: float) -> tuple[float, float, float]
     return float(n @ cz), s, float(n @ cy)
 
 
-def loaded_wire_height(form, x: float, force: float, section: int | None = None) -> float:
-    """Height (m) of the contact wire at ``x`` in the static state of the catenary ``form``
-    pressed up by ``force`` (N) at ``x``: what ``CoupledLine._place_pantographs`` solves (the
-    structure's static equilibrium under the point load, by ``coupled_equilibrium``)."""
+def loaded_catenary(form, xs, forces, sections=None) -> np.ndarray:
+    """The catenary ``form``'s coordinates in its static state pressed up by ``forces`` (N) at
+    ``xs`` (m) on the contact wires ``sections`` (indices; default: the wire in running, lowest
+    at each x), by ``coupled_equilibrium``. Kept on ``form`` for the same loads (a pantograph's
+    placement and the static solve's starting state ask for the same state)."""
     from ..catenary.formfinding import coupled_equilibrium
     from ..interaction.contact import contact_wire_locators, point_loads, running_wire
 
     st = form.structure
     locators = contact_wire_locators(st)
+    xs, forces = [float(x) for x in xs], [float(f) for f in forces]
+    for x in xs:
+        if not any(sec.covers(x) for sec in st.sections):
+            raise ParameterError(f"x={x:g} m: no contact wire there")
+    if sections is None:
+        sections = [running_wire(st, locators, form.q, x) for x in xs]
+    key = (tuple(xs), tuple(forces), tuple(int(k) for k in sections))
+    kept = form.__dict__.setdefault("_loaded_states", {})
+    if key not in kept:
+        if len(kept) > 8:
+            kept.clear()
+        kept[key] = coupled_equilibrium(st, form.q.copy(), point_loads(st.n, locators, list(key[2]), xs, forces))
+    return kept[key].copy()
+
+
+def loaded_wire_height(form, x: float, force: float, section: int | None = None) -> float:
+    """Height (m) of the contact wire at ``x`` in the static state of the catenary ``form``
+    pressed up by ``force`` (N) at ``x``: what ``CoupledLine._place_pantographs`` solves (the
+    structure's static equilibrium under the point load, :func:`loaded_catenary`)."""
+    from ..interaction.contact import contact_wire_locators, running_wire
+
+    st = form.structure
     if not any(sec.covers(x) for sec in st.sections):
         raise ParameterError(f"x={x:g} m: no contact wire there")
+    locators = contact_wire_locators(st)
     if section is None:  # the wire in running: lowest at x
         section = running_wire(st, locators, form.q, x)
-    q = coupled_equilibrium(st, form.q.copy(), point_loads(st.n, locators, [section], [x], [force]))
+    q = loaded_catenary(form, [x], [force], [section])
     return locators[section].locate(q, x).height(q)
 
 

@@ -199,3 +199,22 @@ def test_linear_wires_forces_energy_and_stiffness(form):
     step = 1e-6 * rng.standard_normal(n)
     u_plus, u_minus = lin.strain_energy(q0 + dq + step), lin.strain_energy(q0 + dq - step)
     assert (u_plus - u_minus) == pytest.approx(-2 * f1.ravel() @ step, rel=1e-5)
+
+
+def test_static_solve_from_the_loaded_catenary_is_the_same_equilibrium(form):
+    """The passage's static solve starts with the wires in the catenary's static state under the
+    target force and, for a pantograph placed in equilibrium there, as Newton's method
+    (``ScenePantograph.placed``): the same equilibrium as the pseudo-transient continuation from
+    the unloaded wires, in a third of the iterations or fewer."""
+    from symcat.interaction.scene_pantographs import _static, lumped_fragment, static_force
+
+    panto = benchmark2015_pantograph(SPEED_KMH)
+    target = float(panto.static_force(SPEED).sum())
+    placed = lumped_fragment(panto, form=form)
+    assert placed.placed and not lumped_fragment(panto).placed
+    _, model_a, (element_a,), eq_a = _static(form, [placed], "contact", [X0], SPEED, [panto.uplift], load=target)
+    _, model_b, (element_b,), eq_b = _static(form, [placed], "contact", [X0], SPEED, [panto.uplift])
+    assert eq_a.iterations <= 3 and eq_a.iterations * 3 <= eq_b.iterations
+    assert np.abs(eq_a.q - eq_b.q).max() < 1e-7  # m
+    assert static_force(eq_a, element_a) == pytest.approx(static_force(eq_b, element_b), rel=1e-7)
+    assert static_force(eq_a, element_a) == pytest.approx(target, rel=1e-3)  # the placement's force
