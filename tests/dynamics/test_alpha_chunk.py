@@ -148,6 +148,30 @@ def test_compiled_steps_of_a_spinning_cable_match_the_python_steps(record_proper
     assert compiled.stats["factorizations"] >= 1
 
 
+def test_the_factor_renewed_in_a_call_is_the_next_calls(monkeypatch):
+    """The compiled steps renew their factor in the caller's memory: a call that refactorized
+    leaves it changed (the next call starts from it), one that did not leaves it as it was."""
+    from symcat.integrate.alpha_chunk import CompiledSteps
+
+    seen = []
+    call = CompiledSteps._call
+
+    def watched(self, s, t, n):
+        renew, before = self._renew, self._factor.copy()
+        count = self.integ.compiled_factorizations
+        done = call(self, s, t, n)
+        inside = self.integ.compiled_factorizations - count - renew
+        if not renew:
+            seen.append((inside, not np.array_equal(before, self._factor)))
+        return done
+
+    monkeypatch.setattr(CompiledSteps, "_call", watched)
+    generalized_alpha(cable_pendulum(), 0.5, 1e-3, rho_inf=0.8, tol=1e-10, n_out=20, progress=False,
+                      multipliers="integrator", compiled=True)
+    assert any(inside for inside, _ in seen) and not all(inside for inside, _ in seen)
+    assert all(bool(inside) == changed for inside, changed in seen)
+
+
 def test_compiled_steps_of_a_body_on_a_sliding_joint_match_the_python_steps(record_property):
     """A body, its sliding joint's arc length and multipliers in the border of the matrix."""
     python, compiled = _both(slider, 0.2, 1e-3, rho_inf=0.9, tol=1e-10)
