@@ -287,9 +287,9 @@ def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> tuple
 
 #: Libraries whose loaded functions a process keeps for the next runs (least recently used
 #: first out): a function's evaluation buffers are allocated when it is loaded, and on a line
-#: its work vector takes megabytes, whose allocation and first touch cost as much as a short
-#: run's steps.
-LOADED_LIBRARIES = 4
+#: its work vector takes tens of megabytes (the factorization's graph), whose allocation and
+#: first touch cost as much as a short run's steps; kept for two models, not more.
+LOADED_LIBRARIES = 2
 _LOADED: dict = {}
 
 
