@@ -296,7 +296,9 @@ _LOADED: dict = {}
 def _loaded(path: Path) -> "_Lengths":
     """The functions of the library at ``path``, loaded once per process (see
     :data:`LOADED_LIBRARIES`; the callers bind their own arrays before each call)."""
-    fns = _LOADED.pop(path, None) or _Lengths(path)
+    fns = _LOADED.pop(path, None)
+    if fns is None:  # (not `or`: a library none of whose functions is loaded yet is empty)
+        fns = _Lengths(path)
     _LOADED[path] = fns  # (the most recent last)
     while len(_LOADED) > LOADED_LIBRARIES:
         _LOADED.pop(next(iter(_LOADED)))

@@ -172,6 +172,22 @@ def test_the_factor_renewed_in_a_call_is_the_next_calls(monkeypatch):
     assert all(bool(inside) == changed for inside, changed in seen)
 
 
+def test_loaded_libraries_are_kept_for_the_next_runs_of_two_models(monkeypatch, tmp_path):
+    """A run finds the functions (and their buffers) a former run of its model loaded; a third
+    model's library puts out the least recently used one."""
+    from symcat.integrate import alpha_chunk
+
+    monkeypatch.setattr(alpha_chunk, "_LOADED", {})
+    a, b, c = (tmp_path / f"{name}.so" for name in "abc")  # (functions load at first use: none here)
+    first = alpha_chunk._loaded(a)
+    assert alpha_chunk._loaded(a) is first and first.path == a
+    alpha_chunk._loaded(b)
+    alpha_chunk._loaded(a)  # a used last: b goes first
+    alpha_chunk._loaded(c)
+    assert alpha_chunk._loaded(a) is first
+    assert list(alpha_chunk._LOADED) == [c, a]
+
+
 def test_compiled_steps_of_a_body_on_a_sliding_joint_match_the_python_steps(record_property):
     """A body, its sliding joint's arc length and multipliers in the border of the matrix."""
     python, compiled = _both(slider, 0.2, 1e-3, rho_inf=0.9, tol=1e-10)
