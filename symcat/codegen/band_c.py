@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import os
 import re
+from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
 
@@ -125,6 +126,33 @@ const casadi_int* {name}_sparsity_out(casadi_int i) {{ return {name}_sp[2]; }}
 """
 
 
+_STORE = r"""
+/* symcat store: {n} numbers into a caller's buffer of {size} at {at} (symcat.codegen.band_c) */
+#ifndef casadi_real
+#define casadi_real double
+#endif
+#ifndef casadi_int
+#define casadi_int long long int
+#endif
+static const casadi_int {name}_sp[3][3] = {{{{{size}, 1, 1}}, {{{n}, 1, 1}}, {{1, 1, 1}}}};
+
+/* (buffer, values) -> 0: the buffer is an input, written in place (its memory is the
+   caller's, see store_function) */
+int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
+  casadi_int i;
+  casadi_real *buffer = (casadi_real*) arg[0];
+  if (buffer && arg[1]) for (i = 0; i < {n}; ++i) buffer[{at} + i] = arg[1][i];
+  if (res[0]) res[0][0] = 0;
+  return 0;
+}}
+
+casadi_int {name}_n_in(void) {{ return 2; }}
+casadi_int {name}_n_out(void) {{ return 1; }}
+const casadi_int* {name}_sparsity_in(casadi_int i) {{ return {name}_sp[i]; }}
+const casadi_int* {name}_sparsity_out(casadi_int i) {{ return {name}_sp[2]; }}
+"""
+
+
 def names(n: int, bw: int) -> tuple[str, str]:
     """The C names of the factorization and the solve for ``n`` unknowns, half-bandwidth ``bw``."""
     return f"symcat_band_lu_{n}_{bw}", f"symcat_band_solve_{n}_{bw}"
@@ -162,6 +190,50 @@ def matvec(m: int, n: int) -> ca.Function:
     return ca.external(f"symcat_matvec_{m}_{n}", str(_library(matvec_source(m, n))))
 
 
+def store_source(size: int, at: int, n: int) -> str:
+    """The C source of ``symcat_store_<size>_<at>_<n>``: ``(buffer, values) -> 0``."""
+    return _STORE.format(name=f"symcat_store_{size}_{at}_{n}", size=size, at=at, n=n)
+
+
+@lru_cache(maxsize=32)
+def store_function(size: int, at: int, n: int) -> ca.Function:
+    """``(buffer, values) -> token``: write the ``n`` ``values`` into ``buffer`` (``size``
+    numbers) from position ``at``, in place, and give 0.
+
+    Why: compiled steps carry a factorization of several hundred kilobytes to megabytes from
+    one Newton iteration, step and call to the next; as a value of the graph every function
+    that keeps it (a step that does not renew it, the steps' outputs) copies it whole. Given
+    as an input whose memory the caller owns, CasADi's generated code hands its pointer on
+    unchanged to every function that reads it, and this kernel writes the renewed parts
+    there. Its result orders the graph: a function that reads the buffer must take the
+    token of the last store as an input (CasADi evaluates a graph in the order of its data),
+    and no store may be taken before a read of the values it replaces (the store's inputs
+    must follow from that read's outputs). The code must be generated with the buffer read
+    in place (:func:`inputs_by_reference`). The buffer is an input: evaluated by CasADi from
+    Python (``DM`` arguments, copied in), the writes do not outlive the call."""
+    return ca.external(f"symcat_store_{size}_{at}_{n}", str(_library(store_source(size, at, n))))
+
+
+#: The size from which CasADi's generated code reads a function's input where the caller
+#: holds it instead of copying it into its work vector (CasADi's global option
+#: ``copy_elision_min_size``, read when the code is generated; this is its default).
+REFERENCED_INPUT_SIZE = 8
+
+
+@contextmanager
+def inputs_by_reference():
+    """Within this context a function added to a CasADi ``CodeGenerator`` (which reads the
+    option then) gets code that reads every input of at least :data:`REFERENCED_INPUT_SIZE`
+    numbers where its caller holds it, as :func:`store_function` needs of the buffer it
+    writes (copied in, a store would be lost when the function that copied it returns)."""
+    size = ca.GlobalOptions.getCopyElisionMinSize()
+    ca.GlobalOptions.setCopyElisionMinSize(min(size, REFERENCED_INPUT_SIZE))
+    try:
+        yield
+    finally:
+        ca.GlobalOptions.setCopyElisionMinSize(size)
+
+
 def _library(text: str) -> Path:
     """The compiled library of the C ``text`` (cached under its digest)."""
     target = cached_library("band", text.encode(), FLAGS)
@@ -190,8 +262,7 @@ def include_in(c_path: Path) -> Path:
     """Append to the generated ``c_path`` the source of every kernel of this module it calls
     (CasADi's code declares and calls them by name), and make its copies ``memmove``: CasADi's
     ``casadi_copy`` loop moves one number per instruction, and the compiled steps copy their
-    factor (16k numbers on the moving load) three times a step; the C library's copy is
-    several times faster. ``casadi_fmax`` is made inline (:data:`_FMAX`). Nothing else of the
+    state and a renewed factor; the C library's copy is several times faster. ``casadi_fmax`` is made inline (:data:`_FMAX`). Nothing else of the
     generated code changes."""
     text = c_path.read_text()
     if _COPY_LOOP in text:
@@ -202,5 +273,7 @@ def include_in(c_path: Path) -> Path:
         parts.append(source(n, bw))
     for m, n in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_matvec_(\d+)_(\d+)\(", text)}):
         parts.append(matvec_source(m, n))
+    for size, at, n in sorted({tuple(map(int, g)) for g in re.findall(r"symcat_store_(\d+)_(\d+)_(\d+)\(", text)}):
+        parts.append(store_source(size, at, n))
     c_path.write_text("".join(parts))
     return c_path

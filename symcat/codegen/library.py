@@ -197,8 +197,10 @@ class BufferedFunction:
         """Evaluate input ``i`` from, and write output ``i`` into, the caller's own array
         (``{i: array}``: contiguous float64 of the right size, kept alive by the caller and
         only written in place): a large argument passed from one call to the next (a
-        factorization carried by compiled steps) then moves by swapping two arrays instead of
-        being copied in and out. An input passed as its bound array itself is not copied."""
+        factorization carried by compiled steps) then stays in the caller's memory instead of
+        being copied in and out. An input passed as its bound array itself is not copied: the
+        compiled code reads it where it is, and code that writes into an input (see
+        :func:`~symcat.codegen.band_c.store_function`) writes into the caller's array."""
         for i, a in (inputs or {}).items():
             if a is not self._inputs[i]:
                 self._check_bound(a, self._inputs[i].size)

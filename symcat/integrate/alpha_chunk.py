@@ -35,12 +35,13 @@ from __future__ import annotations
 
 import hashlib
 import logging
+import re
 from pathlib import Path
 
 import casadi as ca
 import numpy as np
 
-from ..codegen.band_c import include_in
+from ..codegen.band_c import include_in, inputs_by_reference, store_function
 from ..codegen.library import BufferedFunction, symbolic_kernels, write_functions_c
 from ..errors import CompilerError
 from .alpha_bulk import step_data
@@ -55,8 +56,7 @@ log = logging.getLogger(__name__)
 
 #: The compiled calls' lengths in steps (the code holds one call of the step per step; a call
 #: takes the shortest that covers an output interval and skips the steps past it, so one
-#: library serves every step size and output interval; a skipped step still copies the state
-#: and the factor, which on a short interval in a 32-step call cost more than the steps).
+#: library serves every step size and output interval; a skipped step still copies the state).
 LENGTHS = (1, 2, 4, 8, 16, 32)
 MAX_STEPS = LENGTHS[-1]
 #: Newton iterations of a compiled step before it counts as failed (the iteration matrix is
@@ -102,7 +102,7 @@ class CompiledSteps:
     def __init__(self, integ: Integrator, h: float, per: int, build: bool = True):
         self.integ, self.h, self.per, self.build = integ, h, min(int(per), MAX_STEPS), build
         self._fns = None  # length -> compiled function
-        self._factors = None  # the iteration matrix's factor the compiled steps carry (see _prepare)
+        self._factor = None  # the iteration matrix's factor the compiled steps carry (see _prepare)
         self._renew = True  # factorize it at the next call's first step
         self._last = None  # (state, packed) of the last call (see _call)
         self._scale = None
@@ -174,7 +174,7 @@ class CompiledSteps:
         path = existing_library("alpha_chunk", self._record["library"].encode(), optimized_flags=OPTIMIZED_FLAGS)
         if path is None:
             return False
-        self._fns = _Lengths(path)
+        self._fns = _loaded(path)
         st = self.integ.built_stepper
         self._prepare(self._record["mass_scale"] if st is None or st.mass_scale is None else st.mass_scale)
         return True
@@ -183,9 +183,8 @@ class CompiledSteps:
         """The factor's storage (its size the library's), the packed state's layout and the
         Newton tolerance's scale."""
         n_u, n_c, n_sc, n_y = step_sizes(self.integ.form, self.integ.variant)
-        # the factor in two arrays the calls take turns to read and write (no copies, _call)
-        size = self._fns[LENGTHS[0]].function.nnz_in(4)
-        self._factors = (np.zeros(size), np.zeros(size))
+        # the factor's memory, which the calls read and renew in place (no copies, _call)
+        self._factor = np.zeros(self._fns[LENGTHS[0]].function.nnz_in(4))
         self._cuts = _packed_cuts(n_u, n_c, n_sc)[:-2]
         self._mass_scale = mass_scale
         model = self.integ.model
@@ -198,19 +197,18 @@ class CompiledSteps:
         ``min(n, per)`` steps from ``s`` at ``t``."""
         per, h = self.per, self.h
         length = next(L for L in LENGTHS if L >= min(n, per))
-        fn, (factor, other) = self._fns[length], self._factors
+        fn, factor = self._fns[length], self._factor
         last = self._last  # (the state the last call gave, packed): the next call's input as it is
         packed = last[1] if last is not None and last[0] is s else self._pack(s)
         if self._renew:  # the matrix afresh at the first step's predictor
             renew = self._fns["renew"]
-            renew.bind(outputs={0: other})
+            renew.bind(outputs={0: factor})
             renew.outputs(packed, t, h)
-            factor, other = other, factor
             self.integ.compiled_factorizations += 1
-        fn.bind({4: factor}, {1: other})
-        x, _, its, factorizations = fn.outputs(
+        fn.bind({4: factor})  # read and renewed in place: after the call, the factor the steps ended with
+        x, its, factorizations = fn.outputs(
             packed, t + h * np.arange(length), h, min(n, per), factor, float(self._renew), self._scale)
-        self._factors, its = (other, factor), its.copy()  # the factor the steps ended with: the next call's
+        its = its.copy()
         self.integ.compiled_factorizations += int(factorizations[0])
         done = min(int(np.argmin(its > 0)) if its.min() <= 0 else length, n, per)
         self._renew = done < min(n, per)  # a failure: renew the matrix where the next call starts
@@ -271,14 +269,40 @@ def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> tuple
     def write(folder):
         with symbolic_kernels():
             fns = _chunk_functions(st, coef)
-        # the code calls the band's C kernels by name: their source with it
-        return include_in(write_functions_c(fns, "alpha_chunk", folder))
+        # the code calls the band's C kernels by name: their source with it; the factor's
+        # memory is read and written where the caller holds it
+        with inputs_by_reference():
+            path = include_in(write_functions_c(fns, "alpha_chunk", folder))
+        size = fns[0].nnz_in(4)
+        if re.search(rf"casadi_copy\(arg\[\d+\], {size}, ", path.read_text()):
+            raise CompilerError(f"the compiled steps' code copies the factor's memory ({size} numbers) it must write")
+        return path
 
     path = compiled_library("alpha_chunk", key.encode(), write, build=build,  # -O0 first, optimized in the background
                             optimized_flags=OPTIMIZED_FLAGS)
     if path is None:
         return None, key
-    return _Lengths(path), key
+    return _loaded(path), key
+
+
+#: Libraries whose loaded functions a process keeps for the next runs (least recently used
+#: first out): a function's evaluation buffers are allocated when it is loaded, and on a line
+#: its work vector takes tens of megabytes (the factorization's graph), whose allocation and
+#: first touch cost as much as a short run's steps; kept for two models, not more.
+LOADED_LIBRARIES = 2
+_LOADED: dict = {}
+
+
+def _loaded(path: Path) -> "_Lengths":
+    """The functions of the library at ``path``, loaded once per process (see
+    :data:`LOADED_LIBRARIES`; the callers bind their own arrays before each call)."""
+    fns = _LOADED.pop(path, None)
+    if fns is None:  # (not `or`: a library none of whose functions is loaded yet is empty)
+        fns = _Lengths(path)
+    _LOADED[path] = fns  # (the most recent last)
+    while len(_LOADED) > LOADED_LIBRARIES:
+        _LOADED.pop(next(iter(_LOADED)))
+    return fns
 
 
 class _Lengths(dict):
@@ -300,16 +324,16 @@ def _graph(residual: ChunkResidual) -> ca.Function:
 
 
 def _chunk_functions(st: StepEquations, coef) -> list:
-    """``alpha_chunk_<per>(x0, t (per), h, n, factor, renew, scale) -> (x, factor, iterations
-    (per), factorizations)`` for each ``per`` of :data:`LENGTHS`: up to ``n`` steps of ``h``
-    from the packed state ``x0`` at the times ``t``, with the iteration matrix's ``factor``
-    (``renew``: made at the first step's predictor, by ``alpha_chunk_renew``); ``x`` is the
-    state after the last step that converged and ``factor`` the one the steps ended with; a
-    step's iterations are 0 (not taken: past ``n`` or after a failure) or -1 (failed). Then
-    ``alpha_chunk_renew(x0, t0, h) -> factor``: the matrix at the predictor of the step from
-    ``x0`` at ``t0``, which the caller runs before a call that renews it (outside the steps:
-    inside, keeping the factor where it is not renewed copied it at every step, 128 kB on
-    the moving load)."""
+    """``alpha_chunk_<per>(x0, t (per), h, n, factor, renew, scale) -> (x, iterations (per),
+    factorizations)`` for each ``per`` of :data:`LENGTHS`: up to ``n`` steps of ``h`` from the
+    packed state ``x0`` at the times ``t``, with the iteration matrix's ``factor`` (``renew``:
+    made at the first step's predictor, by ``alpha_chunk_renew``); ``x`` is the state after
+    the last step that converged; a step's iterations are 0 (not taken: past ``n`` or after a
+    failure) or -1 (failed). ``factor`` is the caller's memory, read where it is and renewed
+    in place (:func:`~symcat.codegen.band_c.store_function`): after the call it holds the
+    factor the steps ended with, the next call's. Then ``alpha_chunk_renew(x0, t0, h) ->
+    factor``: the matrix at the predictor of the step from ``x0`` at ``t0``, which the caller
+    runs, into the same memory, before a call that renews it."""
     n_u, n_c, n_sc, n_y = st.n_u, st.n_c, st.n_sc, st.n_y
     n_x = 5 * n_u + 2 * (n_c + n_sc) + 2
     y, p = ca.MX.sym("y", n_y), ca.MX.sym("p", 3 * n_u + 4)
@@ -325,16 +349,22 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     jacobian_border = ca.Function("alpha_chunk_jacobian_border", [y_b, y_r, p],
                                   [residual.jacobian(y_b, y_r, p, wires=False)])
     jac = ca.project(jacobian(y[: st.bulk.n_b], y[st.bulk.n_b :], p), layout.pattern)
-    factor = ca.MX.sym("factor", layout.size)
-    factorize = ca.Function("alpha_chunk_factorize", [y, p, factor], [layout.factorize(_nonzeros(jac))])
-    keep_factor = ca.Function("alpha_chunk_keep_factor", [y, p, factor], [factor])
+    # The factor's memory is an input the caller owns (read in place, renewed by stores into
+    # it, never copied); the token of its last store orders the functions that read it after
+    # that store (see band_c.store_function).
+    factor, token = ca.MX.sym("factor", layout.size), ca.MX.sym("token")
+    factorization = ca.Function("alpha_chunk_factorization", [y, p], [layout.factorize(_nonzeros(jac))])
+    store = store_function(layout.size, 0, layout.size)
+    factorize = ca.Function("alpha_chunk_factorize", [y, p, factor, token], [store(factor, factorization(y, p))])
+    keep_factor = ca.Function("alpha_chunk_keep_factor", [y, p, factor, token], [token])
     refresh = ca.Function.if_else("alpha_chunk_refresh", factorize, keep_factor)
     # the border alone (bodies, joints, contacts: what moves with a point), the band's LU kept
     border = layout.n_r > 0
     if border:
         jac_border = ca.project(jacobian_border(y[: st.bulk.n_b], y[st.bulk.n_b :], p), layout.pattern)
-        refactorize_border = ca.Function("alpha_chunk_border", [y, p, factor],
-                                         [layout.refactorize_border(factor, _nonzeros(jac_border))])
+        store_border = store_function(layout.size, layout.band_entries, layout.size - layout.band_entries)
+        refactorize_border = ca.Function("alpha_chunk_border", [y, p, factor, token],
+                                         [store_border(factor, layout.border(factor, _nonzeros(jac_border)))])
         refresh_border = ca.Function.if_else("alpha_chunk_refresh_border", refactorize_border, keep_factor)
     rhs = ca.MX.sym("rhs", n_y)
     solve = ca.Function("alpha_chunk_solve", [factor, rhs], [layout.solve(factor, rhs)])
@@ -353,7 +383,7 @@ def _chunk_functions(st: StepEquations, coef) -> list:
                      ca.MX(n_y - n_u - n_c - n_sc, 1), sc + ratio * (sc - sc_prev))
     predictor = ca.Function("alpha_chunk_predictor", [xk, t0, h], [y_k, p_k])
     # the matrix afresh at a step's predictor (run by the caller before a call that renews it)
-    renew_matrix = ca.Function("alpha_chunk_renew", [xk, t0, h], [factorize(y_k, p_k, ca.MX(layout.size, 1))])
+    renew_matrix = ca.Function("alpha_chunk_renew", [xk, t0, h], [factorization(y_k, p_k)])
 
     # One Newton iteration: (y, previous error, status, count, fresh) -> (y, error, status,
     # count); status 0 running, 1 converged, 2 failed, 3 slow (wants a fresh matrix): the
@@ -372,11 +402,11 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     failed = ca.logic_or(ca.logic_or(ca.logic_not(finite), ca.logic_and(slow, diverging)),
                          count + 1 >= MAX_ITERATIONS)
     new_status = ca.if_else(converged, 1, ca.if_else(failed, 2, ca.if_else(slow, 3, 0)))
-    args = [y, prev, status, count, fresh, p, scale, factor]
+    args = [y, prev, status, count, fresh, p, scale, factor, token]
     iterate = ca.Function("alpha_chunk_iteration", args, [y + dy, err, new_status, count + 1])
     keep = ca.Function("alpha_chunk_keep", args, [y, prev, status, count])
     newton = ca.Function.if_else("alpha_chunk_newton", keep, iterate)
-    # One step: (packed state, factor, renew, t0, h, index, n, scale) -> (state, factor,
+    # One step: (packed state, factor, token, renew, t0, h, index, n, scale) -> (state, token,
     # iterations, factorizations); renew: the factor was made at this step's predictor
     xk, t0, h, index, n = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h"), ca.MX.sym("k"), ca.MX.sym("n")
     scale = ca.MX.sym("scale", n_y + ROUNDS)  # then per round the contraction that is slow
@@ -388,19 +418,19 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     active = ca.logic_and(index < n, was_failed == 0)
     fr = ca.logic_and(active, renew)
     e, stat, cnt = ca.MX(0), ca.if_else(active, 0, 1), ca.MX(0)  # an inactive step: "converged" untouched
-    f_k, factorizations = factor, ca.MX(0)
+    tk, factorizations = token, ca.MX(0)
     for round_ in range(ROUNDS):
         round_scale = ca.vertcat(scale[:n_y], scale[n_y + round_])
         for _ in range(MAX_ITERATIONS // ROUNDS):
-            y_k, e, stat, cnt = newton(stat != 0, y_k, e, stat, cnt, fr, p_k, round_scale, f_k)
+            y_k, e, stat, cnt = newton(stat != 0, y_k, e, stat, cnt, fr, p_k, round_scale, factor, tk)
         wanted = stat == 3
         if round_ == ROUNDS - 1:
             continue
         # slow: the border afresh at the current iterate first, then the whole matrix
         if border and round_ == 0:
-            f_k = refresh_border(wanted, y_k, p_k, f_k)
+            tk = refresh_border(wanted, y_k, p_k, factor, tk)
         else:
-            f_k = refresh(wanted, y_k, p_k, f_k)
+            tk = refresh(wanted, y_k, p_k, factor, tk)
             fr, factorizations = ca.logic_or(fr, wanted), factorizations + wanted
         stat, e = ca.if_else(wanted, 0, stat), ca.if_else(wanted, 0, e)
     ok = ca.logic_and(active, stat == 1)
@@ -410,22 +440,22 @@ def _chunk_functions(st: StepEquations, coef) -> list:
                          y_k[n_y - n_sc :], a, lam, sc, h, 0)
     new_x = ca.if_else(ok, stepped, ca.vertcat(xk[:-1], ca.logic_or(was_failed, active)))
     iterations = ca.if_else(ok, cnt, ca.if_else(active, -1, 0))
-    step = ca.Function("alpha_chunk_step", [xk, factor, renew, t0, h, index, n, scale],
-                       [new_x, f_k, iterations, factorizations])
-    skip = ca.Function("alpha_chunk_skip", [xk, factor, renew, t0, h, index, n, scale], [xk, factor, 0, 0])
+    inputs = [xk, factor, token, renew, t0, h, index, n, scale]
+    step = ca.Function("alpha_chunk_step", inputs, [new_x, tk, iterations, factorizations])
+    skip = ca.Function("alpha_chunk_skip", inputs, [xk, token, 0, 0])
     step = ca.Function.if_else("alpha_chunk_step_or_skip", step, skip)
     # A loop of calls, not mapaccum: its code copies the inputs common to the steps once per
     # step, which cost more than the steps.
     functions = []
     for per in LENGTHS:
         x0, times = ca.MX.sym("x0", n_x), ca.MX.sym("t", per)
-        x, f_out, counts, total = x0, factor, [], 0
+        x, tk, counts, total = x0, ca.MX(0), [], 0
         for k in range(per):  # a failed step leaves the state as it was: x is the last good one
-            x, f_out, count, fk = step(k < n, x, f_out, renew if k == 0 else 0, times[k], h, k, n, scale)
+            x, tk, count, fk = step(k < n, x, factor, tk, renew if k == 0 else 0, times[k], h, k, n, scale)
             counts.append(count)
             total += fk
         functions.append(ca.Function(f"alpha_chunk_{per}", [x0, times, h, n, factor, renew, scale],
-                                     [x, f_out, ca.vertcat(*counts), total]))
+                                     [x, ca.vertcat(*counts), total]))
     return functions + [renew_matrix]
 
 

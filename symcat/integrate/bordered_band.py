@@ -103,22 +103,33 @@ class BorderedBand:
         matrix with the given nonzeros, its band's LU kept (the band's entries are not read)."""
         if not self.n_r:
             return factor
+        return ca.vertcat(factor[: self.band_entries], self.border(factor, nonzeros))
+
+    def border(self, factor: ca.MX, nonzeros: ca.MX) -> ca.MX:
+        """The border's part of the factor (its entries from :attr:`band_entries` on) from the
+        matrix with the given nonzeros and the band's LU in ``factor``: what
+        :meth:`refactorize_border` renews, for a caller that writes it into the factor's
+        memory in place."""
         values = ca.vertcat(nonzeros, 0)
-        return self._with_border(factor[: self.n_b * (2 * self.bw + 1)],
-                                 lambda index: values[index.ravel(order="F").tolist()])
+        return self._border(factor[: self.band_entries], lambda index: values[index.ravel(order="F").tolist()])
 
     def _with_border(self, lu: ca.MX, gather) -> ca.MX:
+        return ca.vertcat(lu, self._border(lu, gather))
+
+    def _border(self, lu: ca.MX, gather) -> ca.MX:
         n_b, n_r, n_e, n_f = self.n_b, self.n_r, self.n_e, self.n_f
         e = ca.reshape(gather(self.e_from), n_b, n_e)
         f = ca.reshape(gather(self.f_from), n_f, n_b)
         d = ca.reshape(gather(self.d_from), n_r, n_r)
-        x = band_functions(n_b, self.bw)[1].map(n_e)(lu, e) if n_b and n_e else ca.MX(n_b, n_e)
+        # a call per column, not a map: a map's code copies the LU it shares once per column
+        solve = band_functions(n_b, self.bw)[1]
+        x = ca.horzcat(*(solve(lu, e[:, j]) for j in range(n_e))) if n_b and n_e else ca.MX(n_b, n_e)
         s = ca.MX(d)
         if n_e and n_f:
             fx = ca.reshape(matvec(n_f, n_b).map(n_e)(ca.vec(f), x), n_f, n_e) if n_b else ca.MX(n_f, n_e)
             s[self.f_rows.tolist(), self.e_cols.tolist()] = s[self.f_rows.tolist(), self.e_cols.tolist()] - fx
         s_inv = ca.solve(s, ca.MX.eye(n_r), "qr")
-        return ca.vertcat(lu, ca.vec(x), ca.vec(f), ca.vec(s_inv))
+        return ca.vertcat(ca.vec(x), ca.vec(f), ca.vec(s_inv))
 
     def solve(self, factor: ca.MX, rhs: ca.MX) -> ca.MX:
         """``A^-1 rhs`` from :meth:`factorize`'s factor."""

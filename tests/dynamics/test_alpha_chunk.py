@@ -148,6 +148,46 @@ def test_compiled_steps_of_a_spinning_cable_match_the_python_steps(record_proper
     assert compiled.stats["factorizations"] >= 1
 
 
+def test_the_factor_renewed_in_a_call_is_the_next_calls(monkeypatch):
+    """The compiled steps renew their factor in the caller's memory: a call that refactorized
+    leaves it changed (the next call starts from it), one that did not leaves it as it was."""
+    from symcat.integrate.alpha_chunk import CompiledSteps
+
+    seen = []
+    call = CompiledSteps._call
+
+    def watched(self, s, t, n):
+        renew, before = self._renew, self._factor.copy()
+        count = self.integ.compiled_factorizations
+        done = call(self, s, t, n)
+        inside = self.integ.compiled_factorizations - count - renew
+        if not renew:
+            seen.append((inside, not np.array_equal(before, self._factor)))
+        return done
+
+    monkeypatch.setattr(CompiledSteps, "_call", watched)
+    generalized_alpha(cable_pendulum(), 0.5, 1e-3, rho_inf=0.8, tol=1e-10, n_out=20, progress=False,
+                      multipliers="integrator", compiled=True)
+    assert any(inside for inside, _ in seen) and not all(inside for inside, _ in seen)
+    assert all(bool(inside) == changed for inside, changed in seen)
+
+
+def test_loaded_libraries_are_kept_for_the_next_runs_of_two_models(monkeypatch, tmp_path):
+    """A run finds the functions (and their buffers) a former run of its model loaded; a third
+    model's library puts out the least recently used one."""
+    from symcat.integrate import alpha_chunk
+
+    monkeypatch.setattr(alpha_chunk, "_LOADED", {})
+    a, b, c = (tmp_path / f"{name}.so" for name in "abc")  # (functions load at first use: none here)
+    first = alpha_chunk._loaded(a)
+    assert alpha_chunk._loaded(a) is first and first.path == a
+    alpha_chunk._loaded(b)
+    alpha_chunk._loaded(a)  # a used last: b goes first
+    alpha_chunk._loaded(c)
+    assert alpha_chunk._loaded(a) is first
+    assert list(alpha_chunk._LOADED) == [c, a]
+
+
 def test_compiled_steps_of_a_body_on_a_sliding_joint_match_the_python_steps(record_property):
     """A body, its sliding joint's arc length and multipliers in the border of the matrix."""
     python, compiled = _both(slider, 0.2, 1e-3, rho_inf=0.9, tol=1e-10)

@@ -1,6 +1,6 @@
-"""The band factorization, band solve and dense product as C loops
-(:mod:`symcat.codegen.band_c`): the numbers of a dense solve and product, and the sources a
-generated file calls appended to it."""
+"""The band factorization, band solve, dense product and store as C loops
+(:mod:`symcat.codegen.band_c`): the numbers of a dense solve and product, the sources a
+generated file calls appended to it, and a store that writes into its caller's memory."""
 from __future__ import annotations
 
 import subprocess
@@ -9,8 +9,8 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from symcat.codegen.band_c import band_functions, include_in, matvec
-from symcat.codegen.library import find_compiler
+from symcat.codegen.band_c import band_functions, include_in, inputs_by_reference, matvec, store_function
+from symcat.codegen.library import BufferedFunction, build_library, find_compiler
 
 
 @pytest.mark.parametrize("n, bw", [(1, 0), (7, 2), (40, 5)])
@@ -74,3 +74,50 @@ def test_generated_code_that_calls_the_kernels_gets_their_source(tmp_path):
     # and it compiles (CasADi's declarations and these definitions agree)
     done = subprocess.run([find_compiler(), "-c", str(path), "-o", str(tmp_path / "caller.o")], capture_output=True)
     assert done.returncode == 0, done.stderr.decode()
+
+
+def _compiled(fn: ca.Function, tmp_path) -> str:
+    """The library of ``fn``'s generated code with the kernels it calls."""
+    import os
+
+    path = tmp_path / f"{fn.name()}.c"
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        with inputs_by_reference():  # (CasADi reads the option when a function is added)
+            gen = ca.CodeGenerator(str(path.name), {"with_header": False})
+            gen.add(fn)
+            gen.generate()
+    finally:
+        os.chdir(cwd)
+    include_in(path)
+    target = tmp_path / f"{fn.name()}.so"
+    build_library(find_compiler(), ("-O1", "-fPIC", "-shared"), path, target)
+    return str(target)
+
+
+def test_a_store_writes_into_the_callers_buffer_and_orders_the_reads(tmp_path):
+    """Compiled code reads a bound input where it is and a store writes into it: a read that
+    takes the store's token sees the new values, one whose outputs the store takes sees the
+    old, and after the call the caller's array holds what was stored (also with CasADi set to
+    copy inputs of that size: the code is generated with them read in place)."""
+    n = 12
+    buffer, values, x = ca.MX.sym("buffer", n), ca.MX.sym("values", 2), ca.MX.sym("x", n)
+    read = ca.Function("read", [buffer, x, ca.MX.sym("token")], [ca.dot(buffer, x)])
+    before = read(buffer, x, 0)
+    token = store_function(n, 3, 2)(buffer, values * before)  # after the read it follows from
+    after = read(buffer, x, token)
+    fn = ca.Function("stored", [buffer, values, x], [before, after])
+    size = ca.GlobalOptions.getCopyElisionMinSize()
+    ca.GlobalOptions.setCopyElisionMinSize(1000)
+    try:
+        stored = BufferedFunction(ca.external("stored", _compiled(fn, tmp_path)))
+    finally:
+        ca.GlobalOptions.setCopyElisionMinSize(size)
+    memory = np.arange(1.0, n + 1)
+    total = memory.sum()
+    stored.bind({0: memory})
+    old, new = (float(v[0]) for v in stored.outputs(memory, np.array([1.0, 2.0]), np.ones(n)))
+    assert old == total
+    assert memory.tolist() == [1.0, 2.0, 3.0, total, 2 * total] + list(np.arange(6.0, n + 1))
+    assert new == memory.sum()
