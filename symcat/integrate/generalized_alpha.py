@@ -167,10 +167,11 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
                  dt=h, rho_inf=coef.rho_inf, variant=variant)
     integ = Integrator(model, form, coef, variant, tol, int(max_iterations), max_halvings, expand, stats)
     state = integ.start(x, z, h)
-    # Without a per-step monitor the steps run compiled, many per call; a short run compiles
-    # them only if asked (``compiled=True``), else uses them if cached.
-    chunks = (CompiledSteps(integ, h, per, build=bool(compiled) or n_steps >= CHUNK_COMPILE_STEPS)
-              if compiled is not False and monitor is None else None)
+    # The steps run compiled, many per call (a step per call with a per-step monitor); a short
+    # run compiles them only if asked (``compiled=True``), else uses them if cached.
+    chunks = (CompiledSteps(integ, h, per if monitor is None else 1,
+                            build=bool(compiled) or n_steps >= CHUNK_COMPILE_STEPS)
+              if compiled is not False else None)
     run.multipliers[0] = state.lam
 
     def contacts(t):
@@ -194,9 +195,14 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
         with integrating():
             for out in range(1, n_outputs + 1):
                 try:
-                    if chunks is not None:
+                    if chunks is not None and monitor is None:
                         state = chunks.advance(state, step * h, per)
                         step += per
+                    elif chunks is not None:
+                        for _ in range(per):
+                            state = chunks.advance(state, step * h, 1)
+                            step += 1
+                            record(step * h)
                     else:
                         for _ in range(per):
                             state = integ.advance(state, step * h, h)
@@ -291,9 +297,9 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
         run then goes through the event-stepping driver, generalized-alpha steps inside its
         calls (:mod:`.alpha_events`), with outputs every ``t_end / n_out``.
     compiled : bool, optional
-        Without ``monitor`` and ``handlers``, run the steps as compiled C, many per call
-        (:mod:`.alpha_chunk`: the same steps to the Newton tolerance; models of a few wires,
-        bodies, joints and contacts); with ``handlers``, compile the rest of each step. The
+        Without ``handlers``, run the steps as compiled C, many per call (one per call with a
+        ``monitor``; :mod:`.alpha_chunk`: the same steps to the Newton tolerance); with
+        ``handlers``, compile the rest of each step. The
         code is compiled once per model and cached. None (default): compiled if cached or if
         the run has at least :data:`CHUNK_COMPILE_STEPS` steps (the rest of wheel/rail steps:
         :data:`COMPILE_STEPS`, and a shorter one has it compiled in the background for the

@@ -279,3 +279,25 @@ def test_compiled_steps_of_a_penalty_contact_that_opens_and_closes(record_proper
     assert apart < 1e-6
     gap = compiled.contacts["contact"]["gap_m"]
     assert (gap > 0).any() and (gap <= 0).any()  # it opened and closed
+
+
+def test_a_per_step_monitor_on_compiled_steps(record_property):
+    """A per-step monitor (what a passage records at every step) with the steps compiled, one to
+    a call: the same records, step for step, as the Python steps', within the Newton
+    tolerance; the contact opens and closes in between."""
+    from tests.dynamics.test_contact import head_under_wire
+
+    def gaps(s):
+        return {"gap_m": s.gap_m.copy(), "head_z_m": s.q[-1]}
+
+    runs = [generalized_alpha(head_under_wire(v0=-2.0)[0], 0.15, 5e-4, rho_inf=0.9, n_out=20, progress=False,
+                              multipliers="integrator", tol=1e-10, variant="index3", monitor=gaps,
+                              compiled=compiled) for compiled in (False, True)]
+    python, compiled = (np.asarray(r.monitored["gap_m"]).ravel() for r in runs)
+    assert runs[1].stats["compiled_steps"] == runs[1].stats["steps"] == 300
+    assert len(runs[1].monitored["t_s"]) == 301
+    assert np.array_equal(runs[1].monitored["t_s"], runs[0].monitored["t_s"])
+    apart = np.abs(compiled - python).max()
+    record_property("apart_m", apart)
+    assert apart < 1e-6
+    assert (compiled > 0).any() and (compiled <= 0).any()
