@@ -147,13 +147,15 @@ class CompiledSteps:
         st = self.integ.stepper
         st.scale_multipliers(s.u)  # the scale of the multipliers' tolerance
         try:
-            graph = _graph(ChunkResidual(st))
-            layout = _layout(st)
-            work = layout.n_b * (layout.bw + 1) ** 2
-            if layout.n_r > MAX_BORDER or work > MAX_BAND_WORK:
-                self.disabled = (f"{layout.n_r} unknowns besides the wires' (at most {MAX_BORDER}), a band "
-                                 f"factorization of {work} operations (at most {MAX_BAND_WORK})")
+            # the sizes first, a bound before the ordering: a model too large builds nothing more
+            work = _least_band_work(st)
+            layout = _layout(st) if st.n_y - st.bulk.n_b <= MAX_BORDER and work <= MAX_BAND_WORK else None
+            work = layout.n_b * (layout.bw + 1) ** 2 if layout is not None else work
+            if st.n_y - st.bulk.n_b > MAX_BORDER or work > MAX_BAND_WORK:
+                self.disabled = (f"{st.n_y - st.bulk.n_b} unknowns besides the wires' (at most {MAX_BORDER}), a "
+                                 f"band factorization of {work} operations or more (at most {MAX_BAND_WORK})")
                 return False
+            graph = _graph(ChunkResidual(st))
             self._fns, library_key = _compiled(st, self.integ.coef, graph, self.build)
             if self._fns is None:
                 self.disabled = "not compiled yet, and a short run (see generalized_alpha's compiled)"
@@ -459,6 +461,18 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     return functions + [renew_matrix]
 
 
+def _least_band_work(st: StepEquations) -> int:
+    """A lower bound of the wires' band factorization's operations, ``n_b (b + 1)^2``, in any
+    ordering: a row of ``k`` entries spans ``k - 1`` columns, so the half-bandwidth is at least
+    ``(k - 1) / 2`` (cheap, unlike the ordering of a line's tens of thousands of unknowns)."""
+    n_b = st.bulk.n_b
+    if not n_b:
+        return 0
+    colind, _ = st.bulk.jacobian.function.sparsity_out(0).get_ccs()
+    widest = int(np.diff(colind).max(initial=1))
+    return n_b * (widest // 2 + 1) ** 2
+
+
 def _layout(st: StepEquations, couplings: tuple | None = None) -> BorderedBand:
     """The iteration matrix's :class:`BorderedBand`: the wires' block in the bulk's pattern,
     the rows and columns of the other unknowns dense; of their couplings to the wires only
@@ -469,9 +483,11 @@ def _layout(st: StepEquations, couplings: tuple | None = None) -> BorderedBand:
         b_colind, b_row = st.bulk.jacobian.function.sparsity_out(0).get_ccs()
         rows += list(b_row)
         cols += np.repeat(np.arange(n_b), np.diff(b_colind)).tolist()
-    border = np.argwhere((np.arange(n)[:, None] >= n_b) | (np.arange(n)[None, :] >= n_b))
-    rows += border[:, 0].tolist()
-    cols += border[:, 1].tolist()
+    # the border: its columns whole, its rows over the wires' columns (n (n - n_b) entries,
+    # not a test of all n^2 places: a line has tens of thousands of unknowns)
+    n_r = n - n_b
+    rows += np.tile(np.arange(n), n_r).tolist() + np.tile(np.arange(n_b, n), n_b).tolist()
+    cols += np.repeat(np.arange(n_b, n), n).tolist() + np.repeat(np.arange(n_b), n_r).tolist()
     return BorderedBand(ca.Sparsity.triplet(n, n, rows, cols), n_b, *(couplings or (None, None)))
 
 

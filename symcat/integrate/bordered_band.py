@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import casadi as ca
 import numpy as np
-from scipy.sparse import csr_matrix
+from scipy.sparse import csr_matrix, identity
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ..codegen.band_c import band_functions, matvec
@@ -57,7 +57,7 @@ class BorderedBand:
         self.nnz = rows.size
         in_b = (rows < n_b) & (cols < n_b)
         pattern = csr_matrix((np.ones(in_b.sum()), (rows[in_b], cols[in_b])), shape=(n_b, n_b))
-        pattern = pattern + pattern.T + csr_matrix(np.eye(n_b)) if n_b else pattern
+        pattern = pattern + pattern.T + identity(n_b, format="csr") if n_b else pattern
         self.perm = reverse_cuthill_mckee(pattern.tocsr(), symmetric_mode=True).astype(int) if n_b else np.zeros(0, int)
         where = np.empty(n_b, int)
         where[self.perm] = np.arange(n_b)
