@@ -137,10 +137,31 @@ def loaded_catenary(form, xs, forces, sections=None) -> np.ndarray:
     key = (tuple(xs), tuple(forces), tuple(int(k) for k in sections))
     kept = form.__dict__.setdefault("_loaded_states", {})
     if key not in kept:
-        if len(kept) > 8:
+        if len(kept) > 16:
             kept.clear()
-        kept[key] = coupled_equilibrium(st, form.q.copy(), point_loads(st.n, locators, list(key[2]), xs, forces))
+        kept[key] = coupled_equilibrium(st, _loaded_start(form, kept, key),
+                                        point_loads(st.n, locators, list(key[2]), xs, forces))
     return kept[key].copy()
+
+
+def _loaded_start(form, kept: dict, key: tuple) -> np.ndarray:
+    """Newton's start for the loaded state ``key`` (points, forces, wires): a kept state of the
+    same points under other forces (an uplift trim's next solve), else the sum of the kept
+    states of each point alone, scaled to its force (the catenary's deflection under these
+    loads is nearly linear: several pantographs placed one by one), else the unloaded state."""
+    xs, forces, wires = key
+    q0 = np.asarray(form.q, float)
+    for (x_k, _, w_k), q in reversed(kept.items()):
+        if x_k == xs and w_k == wires:
+            return q.copy()
+    start = q0.copy()
+    for x, f, w in zip(xs, forces, wires):
+        alone = [(f_k[0], q) for (x_k, f_k, w_k), q in kept.items() if x_k == (x,) and w_k == (w,) and f_k[0]]
+        if not alone:
+            return q0.copy()
+        f_k, q = alone[-1]
+        start += (f / f_k) * (q - q0)
+    return start
 
 
 def loaded_wire_height(form, x: float, force: float, section: int | None = None) -> float:

@@ -218,3 +218,26 @@ def test_static_solve_from_the_loaded_catenary_is_the_same_equilibrium(form):
     assert np.abs(eq_a.q - eq_b.q).max() < 1e-7  # m
     assert static_force(eq_a, element_a) == pytest.approx(static_force(eq_b, element_b), rel=1e-7)
     assert static_force(eq_a, element_a) == pytest.approx(target, rel=1e-3)  # the placement's force
+
+
+def test_loaded_catenary_from_warm_starts_is_the_cold_state(form):
+    """The loaded catenary starts Newton from kept states (the same points under other forces;
+    the sum of each point's state alone, scaled to its force): the same state as from the
+    unloaded catenary."""
+    from symcat.pantograph.lumped_scene import loaded_catenary
+
+    xs, forces = [X0, X0 + 60.0], [150.0, 120.0]
+
+    def cold(f):
+        form.__dict__.pop("_loaded_states", None)
+        return loaded_catenary(form, xs, f)
+
+    reference, reference_up = cold(forces), cold([f + 5.0 for f in forces])
+    form.__dict__.pop("_loaded_states", None)
+    for x, f in zip(xs, forces):
+        loaded_catenary(form, [x], [0.8 * f])  # each point alone, at other forces
+    summed = loaded_catenary(form, xs, forces)  # started from the scaled sum
+    again = loaded_catenary(form, xs, [f + 5.0 for f in forces])  # started from the state just solved
+    assert np.abs(summed - reference).max() < 1e-8 and np.abs(again - reference_up).max() < 1e-8
+    assert np.abs(reference_up - reference).max() > 1e-4  # the forces matter
+    form.__dict__.pop("_loaded_states", None)
