@@ -7,7 +7,7 @@ import scipy.sparse as sps
 
 from ..catalog import ElementType
 from ..codegen.library import kernel_library
-from .sparse import MatrixScatter, to_scipy, vector_scatter
+from .sparse import MatrixScatter, vector_scatter
 
 
 class ElementSet:
@@ -87,11 +87,16 @@ class ElementSet:
 
     # --- constant numeric pieces ------------------------------------------------------------
     def mass_matrix(self) -> sps.csc_matrix:
-        """Global mass matrix of these elements (exact, constant)."""
-        m = self._map(f"{self.element.name}_mass")(self._p)
-        q = ca.MX.sym("q", 0)
-        fn = ca.Function("mass", [q], [self._scatter_matrix(m)])
-        return to_scipy(fn(ca.DM(0, 1)))
+        """Global mass matrix of these elements (exact, constant), assembled in SciPy from the
+        element matrices: a constant needs no CasADi scatter (whose construction on a line
+        costs more than this assembly)."""
+        n_loc = self.indices.shape[1]
+        blocks = np.array(self._map(f"{self.element.name}_mass")(self._p)).reshape(n_loc, self.n, n_loc)
+        rows = np.broadcast_to(self.indices[:, :, None], (self.n, n_loc, n_loc))
+        cols = np.broadcast_to(self.indices[:, None, :], (self.n, n_loc, n_loc))
+        values = blocks.transpose(1, 0, 2)  # element, local row, local column
+        kept = (rows >= 0) & (cols >= 0) & (values != 0)
+        return sps.csc_matrix((values[kept], (rows[kept], cols[kept])), shape=(self.n_global, self.n_global))
 
     def gravity(self, g: np.ndarray) -> np.ndarray:
         """Generalized gravity force for the gravity vector ``g`` (m/s^2)."""

@@ -51,6 +51,16 @@ def test_mass_matrix_total_mass_and_sparsity():
     v[0::6] = 1.0  # rigid x translation: position x-coordinates only
     assert v @ (m @ v) == pytest.approx(wire.mass(), rel=1e-12)
     assert sps.issparse(m) and m.nnz < 0.2 * system.n**2
+    # the SciPy assembly against the elements' matrices scattered by the CasADi graph that
+    # assembles the stiffness
+    import casadi as ca
+
+    from symcat.assembly.sparse import to_scipy
+
+    es = system.element_sets[0]
+    blocks = es._map(f"{es.element.name}_mass")(es._p)
+    scattered = to_scipy(ca.Function("mass", [ca.MX.sym("q", 0)], [es._scatter_matrix(blocks)])(ca.DM(0, 1)))
+    assert abs(es.mass_matrix() - scattered).max() <= 1e-15 * abs(scattered).max()
 
 
 def test_sparse_and_dense_eigensolvers_agree(monkeypatch):
