@@ -42,15 +42,15 @@ import casadi as ca
 import numpy as np
 
 from ..codegen.band_c import include_in, inputs_by_reference, store_function
-from ..codegen.library import BufferedFunction, symbolic_kernels, write_functions_c
+from ..codegen.library import symbolic_kernels, write_functions_c
 from ..errors import CompilerError
 from .alpha_bulk import step_data
-from .alpha_chunk_cache import model_key, read_record, write_record
+from .alpha_chunk_cache import loaded, model_key, read_record, write_record
 from .alpha_chunk_residual import ChunkResidual
 from .alpha_integrator import Integrator, State
 from .alpha_newton import SLOW_CONTRACTION
 from .alpha_step import StepEquations, step_sizes
-from .bordered_band import BorderedBand
+from .bordered_band import least_band_work, step_layout
 
 log = logging.getLogger(__name__)
 
@@ -148,12 +148,13 @@ class CompiledSteps:
         st.scale_multipliers(s.u)  # the scale of the multipliers' tolerance
         try:
             # the sizes first, a bound before the ordering: a model too large builds nothing more
-            work = _least_band_work(st)
-            layout = _layout(st) if st.n_y - st.bulk.n_b <= MAX_BORDER and work <= MAX_BAND_WORK else None
-            work = layout.n_b * (layout.bw + 1) ** 2 if layout is not None else work
-            if st.n_y - st.bulk.n_b > MAX_BORDER or work > MAX_BAND_WORK:
-                self.disabled = (f"{st.n_y - st.bulk.n_b} unknowns besides the wires' (at most {MAX_BORDER}), a "
-                                 f"band factorization of {work} operations or more (at most {MAX_BAND_WORK})")
+            n_r, work = st.n_y - st.bulk.n_b, least_band_work(st)
+            if n_r <= MAX_BORDER and work <= MAX_BAND_WORK:
+                layout = step_layout(st)
+                work = layout.n_b * (layout.bw + 1) ** 2
+            if n_r > MAX_BORDER or work > MAX_BAND_WORK:
+                self.disabled = (f"{n_r} unknowns besides the wires' (at most {MAX_BORDER}), a band "
+                                 f"factorization of {work} operations or more (at most {MAX_BAND_WORK})")
                 return False
             graph = _graph(ChunkResidual(st))
             self._fns, library_key = _compiled(st, self.integ.coef, graph, self.build)
@@ -176,7 +177,7 @@ class CompiledSteps:
         path = existing_library("alpha_chunk", self._record["library"].encode(), optimized_flags=OPTIMIZED_FLAGS)
         if path is None:
             return False
-        self._fns = _loaded(path)
+        self._fns = loaded(path)
         st = self.integ.built_stepper
         self._prepare(self._record["mass_scale"] if st is None or st.mass_scale is None else st.mass_scale)
         return True
@@ -284,39 +285,7 @@ def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> tuple
                             optimized_flags=OPTIMIZED_FLAGS)
     if path is None:
         return None, key
-    return _loaded(path), key
-
-
-#: Libraries whose loaded functions a process keeps for the next runs (least recently used
-#: first out): a function's evaluation buffers are allocated when it is loaded, and on a line
-#: its work vector takes tens of megabytes (the factorization's graph), whose allocation and
-#: first touch cost as much as a short run's steps; kept for two models, not more.
-LOADED_LIBRARIES = 2
-_LOADED: dict = {}
-
-
-def _loaded(path: Path) -> "_Lengths":
-    """The functions of the library at ``path``, loaded once per process (see
-    :data:`LOADED_LIBRARIES`; the callers bind their own arrays before each call)."""
-    fns = _LOADED.pop(path, None)
-    if fns is None:  # (not `or`: a library none of whose functions is loaded yet is empty)
-        fns = _Lengths(path)
-    _LOADED[path] = fns  # (the most recent last)
-    while len(_LOADED) > LOADED_LIBRARIES:
-        _LOADED.pop(next(iter(_LOADED)))
-    return fns
-
-
-class _Lengths(dict):
-    """The library's functions by length (and ``"renew"``), loaded at first use."""
-
-    def __init__(self, path: Path):
-        super().__init__()
-        self.path = path
-
-    def __missing__(self, length) -> BufferedFunction:
-        fn = self[length] = BufferedFunction(ca.external(f"alpha_chunk_{length}", str(self.path)))
-        return fn
+    return loaded(path), key
 
 
 def _graph(residual: ChunkResidual) -> ca.Function:
@@ -347,7 +316,7 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     shift_of = ca.Function("alpha_chunk_shift", [y, p], [shift]) if st.variant == "stabilized" and n_c else None
     y_b, y_r = ca.MX.sym("y_b", st.bulk.n_b), ca.MX.sym("y_r", n_y - st.bulk.n_b)
     jacobian = ca.Function("alpha_chunk_jacobian", [y_b, y_r, p], [residual.jacobian(y_b, y_r, p)])
-    layout = _layout(st, residual.couplings())
+    layout = step_layout(st, residual.couplings())
     jacobian_border = ca.Function("alpha_chunk_jacobian_border", [y_b, y_r, p],
                                   [residual.jacobian(y_b, y_r, p, wires=False)])
     jac = ca.project(jacobian(y[: st.bulk.n_b], y[st.bulk.n_b :], p), layout.pattern)
@@ -459,36 +428,6 @@ def _chunk_functions(st: StepEquations, coef) -> list:
         functions.append(ca.Function(f"alpha_chunk_{per}", [x0, times, h, n, factor, renew, scale],
                                      [x, ca.vertcat(*counts), total]))
     return functions + [renew_matrix]
-
-
-def _least_band_work(st: StepEquations) -> int:
-    """A lower bound of the wires' band factorization's operations, ``n_b (b + 1)^2``, in any
-    ordering: a row of ``k`` entries spans ``k - 1`` columns, so the half-bandwidth is at least
-    ``(k - 1) / 2`` (cheap, unlike the ordering of a line's tens of thousands of unknowns)."""
-    n_b = st.bulk.n_b
-    if not n_b:
-        return 0
-    colind, _ = st.bulk.jacobian.function.sparsity_out(0).get_ccs()
-    widest = int(np.diff(colind).max(initial=1))
-    return n_b * (widest // 2 + 1) ** 2
-
-
-def _layout(st: StepEquations, couplings: tuple | None = None) -> BorderedBand:
-    """The iteration matrix's :class:`BorderedBand`: the wires' block in the bulk's pattern,
-    the rows and columns of the other unknowns dense; of their couplings to the wires only
-    ``couplings = (e_cols, f_rows)`` (:meth:`.ChunkResidual.couplings`; default: all)."""
-    n_b, n = st.bulk.n_b, st.n_y
-    rows, cols = [], []
-    if n_b:
-        b_colind, b_row = st.bulk.jacobian.function.sparsity_out(0).get_ccs()
-        rows += list(b_row)
-        cols += np.repeat(np.arange(n_b), np.diff(b_colind)).tolist()
-    # the border: its columns whole, its rows over the wires' columns (n (n - n_b) entries,
-    # not a test of all n^2 places: a line has tens of thousands of unknowns)
-    n_r = n - n_b
-    rows += np.tile(np.arange(n), n_r).tolist() + np.tile(np.arange(n_b, n), n_b).tolist()
-    cols += np.repeat(np.arange(n_b, n), n).tolist() + np.repeat(np.arange(n_b), n_r).tolist()
-    return BorderedBand(ca.Sparsity.triplet(n, n, rows, cols), n_b, *(couplings or (None, None)))
 
 
 def _nonzeros(m: ca.MX) -> ca.MX:

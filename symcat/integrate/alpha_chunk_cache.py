@@ -20,6 +20,8 @@ built from it (the model does not follow it: its digest then differs from the on
 kept), or a subclass of :class:`~symcat.assembly.multibody.MultibodyModel`, which may hold
 more. What the key cannot see is a change made to the assembled model's own internals (its
 kernel groups' values, its index maps) after it was built.
+
+A library once loaded is kept for the process's next runs (:func:`loaded`).
 """
 from __future__ import annotations
 
@@ -29,9 +31,11 @@ from collections import OrderedDict
 from functools import lru_cache
 from pathlib import Path
 
+import casadi as ca
 import numpy as np
 
 from ..codegen.fingerprint import Undescribed, digest, scene_digest
+from ..codegen.library import BufferedFunction
 from ..codegen.paths import PACKAGE_DIR, atomic_write, cache_dir, generated_dir, manifest_path, regenerated_dir, \
     tool_versions
 
@@ -126,3 +130,35 @@ def model_memo(model, form, tag: tuple, build):
     else:
         _MEMO.move_to_end(key)
     return found
+
+
+#: Libraries whose loaded functions a process keeps for the next runs (least recently used
+#: first out): a function's evaluation buffers are allocated when it is loaded, and on a line
+#: its work vector takes tens of megabytes (the factorization's graph), whose allocation and
+#: first touch cost as much as a short run's steps; kept for two models, not more.
+LOADED_LIBRARIES = 2
+_LOADED: dict = {}
+
+
+def loaded(path: Path) -> "_Lengths":
+    """The functions of the library at ``path``, loaded once per process (see
+    :data:`LOADED_LIBRARIES`; the callers bind their own arrays before each call)."""
+    fns = _LOADED.pop(path, None)
+    if fns is None:  # (not `or`: a library none of whose functions is loaded yet is empty)
+        fns = _Lengths(path)
+    _LOADED[path] = fns  # (the most recent last)
+    while len(_LOADED) > LOADED_LIBRARIES:
+        _LOADED.pop(next(iter(_LOADED)))
+    return fns
+
+
+class _Lengths(dict):
+    """The library's functions by length (and ``"renew"``), loaded at first use."""
+
+    def __init__(self, path: Path):
+        super().__init__()
+        self.path = path
+
+    def __missing__(self, length) -> BufferedFunction:
+        fn = self[length] = BufferedFunction(ca.external(f"alpha_chunk_{length}", str(self.path)))
+        return fn

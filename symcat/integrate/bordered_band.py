@@ -154,3 +154,33 @@ class BorderedBand:
         back = np.empty(n_b, int)
         back[self.perm] = np.arange(n_b)
         return ca.vertcat(z[back.tolist()] if n_b else ca.MX(0, 1), y_r)
+
+
+def least_band_work(st) -> int:
+    """A lower bound of the wires' band factorization's operations, ``n_b (b + 1)^2``, in any
+    ordering: a row of ``k`` entries spans ``k - 1`` columns, so the half-bandwidth is at least
+    ``(k - 1) / 2`` (cheap, unlike the ordering of a line's tens of thousands of unknowns)."""
+    n_b = st.bulk.n_b
+    if not n_b:
+        return 0
+    colind, _ = st.bulk.jacobian.function.sparsity_out(0).get_ccs()
+    widest = int(np.diff(colind).max(initial=1))
+    return n_b * (widest // 2 + 1) ** 2
+
+
+def step_layout(st, couplings: tuple | None = None) -> BorderedBand:
+    """The iteration matrix's :class:`BorderedBand`: the wires' block in the bulk's pattern,
+    the rows and columns of the other unknowns dense; of their couplings to the wires only
+    ``couplings = (e_cols, f_rows)`` (:meth:`.ChunkResidual.couplings`; default: all)."""
+    n_b, n = st.bulk.n_b, st.n_y
+    rows, cols = [], []
+    if n_b:
+        b_colind, b_row = st.bulk.jacobian.function.sparsity_out(0).get_ccs()
+        rows += list(b_row)
+        cols += np.repeat(np.arange(n_b), np.diff(b_colind)).tolist()
+    # the border: its columns whole, its rows over the wires' columns (n (n - n_b) entries,
+    # not a test of all n^2 places: a line has tens of thousands of unknowns)
+    n_r = n - n_b
+    rows += np.tile(np.arange(n), n_r).tolist() + np.tile(np.arange(n_b, n), n_b).tolist()
+    cols += np.repeat(np.arange(n_b, n), n).tolist() + np.repeat(np.arange(n_b), n_r).tolist()
+    return BorderedBand(ca.Sparsity.triplet(n, n, rows, cols), n_b, *(couplings or (None, None)))

@@ -198,14 +198,10 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
                     if chunks is not None and monitor is None:
                         state = chunks.advance(state, step * h, per)
                         step += per
-                    elif chunks is not None:
+                    else:  # step by step, each recorded
                         for _ in range(per):
-                            state = chunks.advance(state, step * h, 1)
-                            step += 1
-                            record(step * h)
-                    else:
-                        for _ in range(per):
-                            state = integ.advance(state, step * h, h)
+                            state = (chunks.advance(state, step * h, 1) if chunks is not None
+                                     else integ.advance(state, step * h, h))
                             step += 1
                             record(step * h)
                 except StepFailure as fail:

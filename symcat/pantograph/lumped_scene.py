@@ -118,29 +118,42 @@ def wire_height(scene: Scene, wire: str, x: float) -> tuple[float, float, float]
     return float(n @ cz), s, float(n @ cy)
 
 
-def loaded_catenary(form, xs, forces, sections=None) -> np.ndarray:
-    """The catenary ``form``'s coordinates in its static state pressed up by ``forces`` (N) at
-    ``xs`` (m) on the contact wires ``sections`` (indices; default: the wire in running, lowest
-    at each x), by ``coupled_equilibrium``. Kept on ``form`` for the same loads (a pantograph's
-    placement and the static solve's starting state ask for the same state)."""
-    from ..catenary.formfinding import coupled_equilibrium
-    from ..interaction.contact import contact_wire_locators, point_loads, running_wire
+def running_sections(form, xs) -> list[int]:
+    """The contact wire in running (the lowest) at each ``x`` (m) of ``xs`` in the static
+    catenary ``form`` (indices of ``form.structure.contacts``)."""
+    from ..interaction.contact import contact_wire_locators, running_wire
 
     st = form.structure
+    _check_covered(st, xs)
     locators = contact_wire_locators(st)
-    xs, forces = [float(x) for x in xs], [float(f) for f in forces]
+    return [running_wire(st, locators, form.q, float(x)) for x in xs]
+
+
+def _check_covered(structure, xs) -> None:
     for x in xs:
-        if not any(sec.covers(x) for sec in st.sections):
+        if not any(sec.covers(x) for sec in structure.sections):
             raise ParameterError(f"x={x:g} m: no contact wire there")
-    if sections is None:
-        sections = [running_wire(st, locators, form.q, x) for x in xs]
+
+
+def loaded_catenary(form, xs, forces, sections=None) -> np.ndarray:
+    """The catenary ``form``'s coordinates in its static state pressed up by ``forces`` (N) at
+    ``xs`` (m) on the contact wires ``sections`` (indices; default: the wire in running,
+    :func:`running_sections`), by ``coupled_equilibrium``. Kept on ``form`` for the same loads
+    (a pantograph's placement and the static solve's starting state ask for the same state)."""
+    from ..catenary.formfinding import coupled_equilibrium
+    from ..interaction.contact import contact_wire_locators, point_loads
+
+    st = form.structure
+    xs, forces = [float(x) for x in xs], [float(f) for f in forces]
+    _check_covered(st, xs)
+    sections = running_sections(form, xs) if sections is None else sections
     key = (tuple(xs), tuple(forces), tuple(int(k) for k in sections))
     kept = form.__dict__.setdefault("_loaded_states", {})
     if key not in kept:
         if len(kept) > 16:
             kept.clear()
         kept[key] = coupled_equilibrium(st, _loaded_start(form, kept, key),
-                                        point_loads(st.n, locators, list(key[2]), xs, forces))
+                                        point_loads(st.n, contact_wire_locators(st), list(key[2]), xs, forces))
     return kept[key].copy()
 
 
@@ -168,16 +181,12 @@ def loaded_wire_height(form, x: float, force: float, section: int | None = None)
     """Height (m) of the contact wire at ``x`` in the static state of the catenary ``form``
     pressed up by ``force`` (N) at ``x``: what ``CoupledLine._place_pantographs`` solves (the
     structure's static equilibrium under the point load, :func:`loaded_catenary`)."""
-    from ..interaction.contact import contact_wire_locators, running_wire
+    from ..interaction.contact import contact_wire_locators
 
-    st = form.structure
-    if not any(sec.covers(x) for sec in st.sections):
-        raise ParameterError(f"x={x:g} m: no contact wire there")
-    locators = contact_wire_locators(st)
-    if section is None:  # the wire in running: lowest at x
-        section = running_wire(st, locators, form.q, x)
+    _check_covered(form.structure, [x])
+    section = running_sections(form, [x])[0] if section is None else section
     q = loaded_catenary(form, [x], [force], [section])
-    return locators[section].locate(q, x).height(q)
+    return contact_wire_locators(form.structure)[section].locate(q, x).height(q)
 
 
 def add_lumped_pantograph(scene: Scene, pantograph: LumpedPantograph, wire: str, x0: float, speed: float,

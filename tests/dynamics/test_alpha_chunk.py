@@ -175,17 +175,17 @@ def test_the_factor_renewed_in_a_call_is_the_next_calls(monkeypatch):
 def test_loaded_libraries_are_kept_for_the_next_runs_of_two_models(monkeypatch, tmp_path):
     """A run finds the functions (and their buffers) a former run of its model loaded; a third
     model's library puts out the least recently used one."""
-    from symcat.integrate import alpha_chunk
+    from symcat.integrate import alpha_chunk_cache as cache
 
-    monkeypatch.setattr(alpha_chunk, "_LOADED", {})
+    monkeypatch.setattr(cache, "_LOADED", {})
     a, b, c = (tmp_path / f"{name}.so" for name in "abc")  # (functions load at first use: none here)
-    first = alpha_chunk._loaded(a)
-    assert alpha_chunk._loaded(a) is first and first.path == a
-    alpha_chunk._loaded(b)
-    alpha_chunk._loaded(a)  # a used last: b goes first
-    alpha_chunk._loaded(c)
-    assert alpha_chunk._loaded(a) is first
-    assert list(alpha_chunk._LOADED) == [c, a]
+    first = cache.loaded(a)
+    assert cache.loaded(a) is first and first.path == a
+    cache.loaded(b)
+    cache.loaded(a)  # a used last: b goes first
+    cache.loaded(c)
+    assert cache.loaded(a) is first
+    assert list(cache._LOADED) == [c, a]
 
 
 def test_compiled_steps_of_a_body_on_a_sliding_joint_match_the_python_steps(record_property):
@@ -308,12 +308,13 @@ def test_the_band_work_bound_is_a_lower_bound_and_refuses_a_long_wire():
     ordering and layout cost seconds, for steps that then stay in Python): the bound holds on
     the models the compiled steps take, and a long wire is refused by it."""
     from symcat.dae.formulation import Formulation
-    from symcat.integrate.alpha_chunk import MAX_BAND_WORK, _layout, _least_band_work
+    from symcat.integrate.alpha_chunk import MAX_BAND_WORK
+    from symcat.integrate.bordered_band import least_band_work, step_layout
     from symcat.integrate.alpha_integrator import step_equations
 
     for make in (moving_load, cable_pendulum):
         st = step_equations(Formulation(make(), "augmented", "1"), "stabilized", compiled=None)
-        layout = _layout(st)
-        assert 0 < _least_band_work(st) <= layout.n_b * (layout.bw + 1) ** 2 <= MAX_BAND_WORK
+        layout = step_layout(st)
+        assert 0 < least_band_work(st) <= layout.n_b * (layout.bw + 1) ** 2 <= MAX_BAND_WORK
     run = generalized_alpha(cable_pendulum(400), 2e-3, 1e-3, n_out=1, progress=False, compiled=True)
     assert "compiled_steps" not in run.stats
