@@ -17,15 +17,14 @@ import time
 import weakref
 from dataclasses import dataclass, field
 
-import casadi as ca
 import numpy as np
 import scipy.linalg.lapack as lapack
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
+from ..assembly.sparse import Congruence
 from ..assembly.system import System
-from ..codegen.library import BufferedFunction
 from ..errors import SolverError
 from ..progress import Progress
 
@@ -155,15 +154,17 @@ def _load_scale(system: System, newton: "_FreeNewton", q: np.ndarray) -> float:
 
 
 class _FreeNewton:
-    """The static residual and tangent on the free coordinates, compiled as one function, and
-    the linear solve of a Newton step.
+    """The static residual and tangent on the free coordinates, and the linear solve of a
+    Newton step.
 
-    ``(q, load_factor) -> (R_f, J_ff, R)``, the free rows (and columns) of
-    :attr:`System.static_functions` and the whole residual, is one CasADi function evaluated into
-    NumPy buffers. The tangent's nonzeros go into LAPACK band storage through a
-    precomputed index (reverse Cuthill-McKee order) and are factorized by ``dgbsv``; when the
-    reordered tangent is not banded enough, SuperLU factorizes it in CSC form instead.
-    Built once per system (and set of free coordinates) and reused by later solves.
+    The residual ``f_int(q) + lambda f_ext(q)`` and its tangent are evaluated numerically
+    (:meth:`System.eval_internal_force`, :meth:`System.eval_force_jacobians`: the element
+    kernels mapped and scattered in NumPy) and the tangent's free block taken by a fixed linear
+    map of its nonzeros (:class:`~symcat.assembly.sparse.Congruence`). Its nonzeros go into
+    LAPACK band storage through a precomputed index (reverse Cuthill-McKee order) and are
+    factorized by ``dgbsv``; when the reordered tangent is not banded enough, SuperLU
+    factorizes it in CSC form instead. Built once per system (and set of free coordinates)
+    and reused by later solves.
     """
 
     _CACHE: "weakref.WeakKeyDictionary[System, dict]" = weakref.WeakKeyDictionary()
@@ -179,18 +180,13 @@ class _FreeNewton:
 
     def __init__(self, system: System, free: np.ndarray):
         n = system.n
+        self.system = system
         self.free = free
         nf = free.size
-        q = ca.MX.sym("q", n)
-        lam = ca.MX.sym("load_factor")
-        residual, jacobian = system.static_functions(q, lam)
-        rows = free.tolist()
-        fn = ca.Function("static_free", [q, lam],
-                         [ca.densify(residual[rows]), jacobian[rows, rows], ca.densify(residual)],
-                         ["q", "load_factor"], ["residual", "jacobian", "full_residual"])
-        self._fn = BufferedFunction(fn)
-        colind, row = fn.sparsity_out(1).get_ccs()
-        colind, row = np.array(colind, int), np.array(row, int)
+        k_sum = system.force_jacobian_patterns(damping=False)[0]
+        pick = sps.csr_matrix((np.ones(nf), (free, np.arange(nf))), shape=(n, nf))
+        self._free_block = Congruence(pick, k_sum.indptr, k_sum.indices)
+        colind, row = self._free_block.indptr, self._free_block.indices
         col = np.repeat(np.arange(nf), np.diff(colind))
         pattern = sps.csc_matrix((np.ones(row.size), row, colind), shape=(nf, nf))
         self._csc = (row, colind, (nf, nf))
@@ -210,15 +206,17 @@ class _FreeNewton:
             self._band_shape = shape
 
     def evaluate(self, q: np.ndarray, load_factor: float) -> tuple[np.ndarray, np.ndarray]:
-        """Free residual and the tangent's nonzeros (CasADi's column-major order) at ``q``."""
-        return self._fn.nonzeros(q, load_factor)[:2]
+        """Free residual and the tangent's nonzeros (the free block's CSC order) at ``q``."""
+        k = self.system.eval_force_jacobians(q, load_factor=load_factor)[0]
+        return self.full_residual(q, load_factor)[self.free], -self._free_block.data(k.data)
 
     def residual(self, q: np.ndarray, load_factor: float) -> np.ndarray:
-        return self.evaluate(q, load_factor)[0]
+        return self.full_residual(q, load_factor)[self.free]
 
     def full_residual(self, q: np.ndarray, load_factor: float) -> np.ndarray:
         """Residual on every coordinate (minus the reactions on the fixed ones)."""
-        return self._fn.nonzeros(q, load_factor)[2]
+        system = self.system
+        return system.eval_internal_force(q) + load_factor * system.external_force_value(q)
 
     def solve(self, jac_nz: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
         """``J_ff^-1 rhs`` (None if the tangent is singular)."""

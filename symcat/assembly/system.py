@@ -12,7 +12,7 @@ from ..scene.loads import NodalForce, NodalMass, SlopeMoment
 from ..scene.scene import Scene
 from .dofs import DofMap
 from .element_set import ElementSet
-from .sparse import to_scipy, vector_scatter
+from .sparse import PatternSum, to_casadi_sparse, vector_scatter
 
 
 class System:
@@ -72,22 +72,15 @@ class System:
         caller may then evaluate them as one sparse product."""
         if not self.scene.linear_wires or self._moments or any(es.damped for es in self.element_sets):
             return None
-        f_ref, k_ref, q_ref = self._linearization
-        return (np.array(f_ref, float).ravel() + self._constant_load, to_scipy(k_ref).tocsr(),
-                np.array(q_ref, float).ravel())
+        f_ref, k_ref, q_ref = self._linear_reference
+        return f_ref + self._constant_load, k_ref.tocsr(), q_ref.copy()
 
     @cached_property
     def _linearization(self) -> tuple[ca.DM, ca.DM, ca.DM]:
         """Elastic forces and tangent stiffness at the initial coordinates, and those
-        coordinates (the reference of ``linear_wires``)."""
-        q = ca.MX.sym("q", self.n)
-        f, k = (ca.MX(self.n, 1), ca.MX(self.n, self.n))
-        for es in self.element_sets:
-            f += es.force(q)
-            k += es.stiffness(q)
-        q_ref = ca.DM(self.dofs.q0)
-        f_ref, k_ref = ca.Function("linearization", [q], [f, k])(q_ref)
-        return ca.DM(f_ref), ca.DM(k_ref), q_ref
+        coordinates (the reference of ``linear_wires``), as CasADi constants for the graphs."""
+        f_ref, k_ref, q_ref = self._linear_reference
+        return ca.DM(f_ref), to_casadi_sparse(k_ref), ca.DM(q_ref)
 
     def external_force(self, q: ca.MX) -> ca.MX:
         """Gravity, dead nodal forces and slope moments."""
@@ -158,38 +151,10 @@ class System:
         return fn
 
     # --- compiled numeric functions -------------------------------------------------------
-    @cached_property
-    def static_functions(self) -> ca.Function:
-        """``(q, load_factor) -> (residual, jacobian)`` of ``f_int(q) + lambda f_ext(q) = 0``."""
-        q = ca.MX.sym("q", self.n)
-        lam = ca.MX.sym("load_factor")
-        f_ext = self.external_force(q)
-        residual = self.internal_force(q) + lam * f_ext
-        jac = -self.tangent_stiffness(q)
-        if self._moments:
-            jac += lam * ca.jacobian(self._moment_force(q), q)
-        return ca.Function("static", [q, lam], [residual, jac], ["q", "load_factor"], ["residual", "jacobian"])
-
     def eval_static(self, q: np.ndarray, load_factor: float) -> tuple[np.ndarray, sps.csc_matrix]:
-        r_nz, j_nz = self._static_buffered.nonzeros(q, load_factor)
-        r = np.zeros(self.n)
-        r[self._static_patterns[0]] = r_nz
-        j_colind, j_rows = self._static_patterns[1:]
-        return r, sps.csc_matrix((j_nz, j_rows.copy(), j_colind.copy()), shape=(self.n, self.n))
-
-    @cached_property
-    def _static_buffered(self) -> BufferedFunction:
-        """:attr:`static_functions` evaluated into NumPy arrays: the Jacobian's nonzeros and
-        pattern do not pass through Python lists (two thirds of the time of a plain call on a
-        200-coordinate beam)."""
-        return BufferedFunction(self.static_functions)
-
-    @cached_property
-    def _static_patterns(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Rows of the residual's nonzeros, and the Jacobian's column pointers and rows."""
-        fn = self.static_functions
-        j_colind, j_rows = fn.sparsity_out(1).get_ccs()
-        return np.array(fn.sparsity_out(0).get_ccs()[1], dtype=int), np.array(j_colind), np.array(j_rows)
+        """Residual ``f_int(q) + load_factor f_ext(q)`` (N) and its Jacobian (SciPy CSC) at ``q``."""
+        r = self.eval_internal_force(q) + load_factor * self.external_force_value(q)
+        return r, -self.eval_force_jacobians(q, load_factor=load_factor)[0]
 
     def strain_energy_expr(self, q: ca.MX) -> ca.MX:
         """Strain energy (J) at ``q``; with ``linear_wires`` the energy whose gradient is the
@@ -247,8 +212,7 @@ class System:
                 q = self.dofs.q0.copy()
                 if not isinstance(item.stiffness_at, str):
                     q[idx] = np.asarray(item.stiffness_at, dtype=float)
-                qs = ca.MX.sym("q", self.n)
-                k0 = to_scipy(ca.DM(ca.Function("k0", [qs], [self.tangent_stiffness(qs)])(q))).tocsc()[idx][:, idx]
+                k0 = self.eval_tangent_stiffness(q)[idx][:, idx]
             block = item.alpha * self.mass_matrix[idx][:, idx]
             if item.beta:
                 block = block + item.beta * k0
@@ -257,13 +221,96 @@ class System:
         c.eliminate_zeros()
         return sps.csc_matrix(c)
 
+    # --- numeric evaluation (NumPy/SciPy, no CasADi graph over the global coordinates) -------
     def external_force_value(self, q: np.ndarray) -> np.ndarray:
-        return self._constant_load + (np.asarray(self._ext_fn(ca.DM(q))).ravel() if self._moments else 0.0)
+        """:meth:`external_force` at ``q`` (NumPy)."""
+        return self._constant_load + (self._moment_terms.nonzeros(q)[0] if self._moments else 0.0)
+
+    def eval_internal_force(self, q: np.ndarray, q_dot: np.ndarray | None = None) -> np.ndarray:
+        """:meth:`internal_force` at ``q`` (and ``q_dot``) (NumPy)."""
+        if self.scene.linear_wires:
+            f_ref, k_ref, q_ref = self._linear_reference
+            f = f_ref - k_ref @ (q - q_ref)
+        else:
+            f = np.zeros(self.n)
+            for es in self.element_sets:
+                f += es.eval_force(q)
+        if q_dot is not None:
+            for es in self.element_sets:
+                if es.damped:
+                    f += es.eval_damping(q, q_dot)
+        return f
+
+    def eval_tangent_stiffness(self, q: np.ndarray) -> sps.csc_matrix:
+        """:meth:`tangent_stiffness` at ``q`` (SciPy CSC, a pattern fixed for the system)."""
+        if self.scene.linear_wires:
+            return self._linear_reference[1].copy()
+        return self._stiffness_sum.csc([es.eval_stiffness(q).data for es in self.element_sets])
 
     @cached_property
-    def _ext_fn(self) -> ca.Function:
+    def _stiffness_sum(self) -> PatternSum:
+        """The element sets' stiffness patterns summed."""
+        return PatternSum([(pt.indptr, pt.indices) for pt in (es.stiffness_pattern() for es in self.element_sets)],
+                          (self.n, self.n))
+
+    def eval_force_jacobians(self, q: np.ndarray, q_dot: np.ndarray | None = None, load_factor: float = 1.0):
+        """``-d f / d q`` and ``-d f / d q_dot`` (SciPy CSC, each on a pattern fixed for the
+        system, :meth:`force_jacobian_patterns`) of ``f = internal_force(q, q_dot) +
+        load_factor external_force(q)``; without ``q_dot`` the damping is left out and the
+        second is None."""
+        terms, rates = self._force_jacobian_terms(q, q_dot, load_factor)
+        k_sum, c_sum = self._jacobian_sums(q_dot is not None)
+        return k_sum.csc(terms), (c_sum.csc(rates) if q_dot is not None else None)
+
+    def force_jacobian_patterns(self, damping: bool = True):
+        """The :class:`~.sparse.PatternSum` of each result of :meth:`eval_force_jacobians`
+        (with ``damping``: with velocities)."""
+        return self._jacobian_sums(damping)
+
+    def _force_jacobian_terms(self, q, q_dot, load_factor):
+        """The terms of :meth:`eval_force_jacobians` in the order of :meth:`_jacobian_sums`."""
+        terms, rates = [self.eval_tangent_stiffness(q).data], []
+        if q_dot is not None:
+            for es in self.element_sets:
+                if es.damped:
+                    d, c = es.eval_damping_matrices(q, q_dot)
+                    terms.append(d.data)
+                    rates.append(c.data)
+        if self._moments:
+            terms.append(-load_factor * self._moment_terms.nonzeros(q)[1])
+        return terms, rates
+
+    def _jacobian_sums(self, damping: bool):
+        cache = self.__dict__.setdefault("_jacobian_sum_cache", {})
+        if damping not in cache:
+            shape = (self.n, self.n)
+            k = self._linear_reference[1] if self.scene.linear_wires else self._stiffness_sum
+            k_patterns, c_patterns = [(k.indptr, k.indices)], []
+            if damping:
+                for es in self.element_sets:
+                    if es.damped:
+                        for out, patterns in ((0, k_patterns), (1, c_patterns)):
+                            pt = es._pattern("damping_matrices", out)
+                            patterns.append((pt.indptr, pt.indices))
+            if self._moments:
+                colind, row = self._moment_terms.function.sparsity_out(1).get_ccs()
+                k_patterns.append((np.array(colind), np.array(row)))
+            cache[damping] = (PatternSum(k_patterns, shape), PatternSum(c_patterns, shape))
+        return cache[damping]
+
+    @cached_property
+    def _moment_terms(self) -> BufferedFunction:
+        """``q -> (moment force, its Jacobian)`` of the slope moments."""
         q = ca.MX.sym("q", self.n)
-        return ca.Function("moments", [q], [self._moment_force(q)])
+        f = self._moment_force(q)
+        return BufferedFunction(ca.Function("moments", [q], [ca.densify(f), ca.jacobian(f, q)]))
+
+    @cached_property
+    def _linear_reference(self) -> tuple[np.ndarray, sps.csc_matrix, np.ndarray]:
+        """The linearization of :attr:`_linearization` in NumPy/SciPy (``K`` sorted CSC)."""
+        q_ref = np.array(self.dofs.q0, float)
+        f_ref = sum((es.eval_force(q_ref) for es in self.element_sets), np.zeros(self.n))
+        return f_ref, self._stiffness_sum.csc([es.eval_stiffness(q_ref).data for es in self.element_sets]), q_ref
 
     def body_slice(self, name: str) -> slice:
         body = self.scene.body(name)

@@ -9,12 +9,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import casadi as ca
 import numpy as np
 import scipy.sparse as sps
 
 from ..assembly.system import System
-from ..codegen.library import BufferedFunction
 from ..errors import ParameterError
 from ..scene import AncfBody, Material, NodalForce, Scene, Section
 from .design import CatenaryDesign
@@ -172,12 +170,7 @@ class CatenaryStructure:
         self.cw_zx = np.concatenate([idx(b, "z_x") for b in self.contacts])
         self.cw_xx = np.concatenate([idx(b, "x_x") for b in self.contacts])
         self._lumped = self._lumped_masses()
-        q = ca.MX.sym("q", self.n)
         self._linear = None
-        self._f_int = BufferedFunction(ca.Function("catenary_internal", [q], [ca.densify(self.system.internal_force(q))]))
-        # evaluated in place on NumPy memory: a DM result converted to SciPy costs more than the
-        # stiffness of a long line itself
-        self._k_int = BufferedFunction(ca.Function("catenary_stiffness", [q], [self.system.tangent_stiffness(q)]))
         self._f_ext = self.system.external_force_value(self.system.dofs.q0) - self._lumped * d.gravity * self._z_mask()
 
     def _z_mask(self) -> np.ndarray:
@@ -238,7 +231,7 @@ class CatenaryStructure:
     def forces(self, q: np.ndarray, v: np.ndarray | None = None) -> np.ndarray:
         """Total generalized force (N) on the catenary except contact and Rayleigh damping:
         wire elasticity, gravity, end tensions, droppers and support springs."""
-        f = (self._f_int.nonzeros(q)[0] if self._linear is None else self._linear(q)) + self._f_ext
+        f = (self.system.eval_internal_force(q) if self._linear is None else self._linear(q)) + self._f_ext
         e, _, tension = self.dropper_state(q, v)
         ft = tension[:, None] * e
         ia, ib = self.cw_xyz[self.dropper_nodes], self.mw_xyz[self.dropper_nodes]
@@ -252,7 +245,7 @@ class CatenaryStructure:
     def stiffness(self, q: np.ndarray, droppers_taut: bool | None = None) -> sps.csc_matrix:
         """Tangent stiffness ``-d forces / d q`` (sparse). ``droppers_taut=True`` counts every
         dropper as taut (the iteration matrix of a dynamic run); default: the current state."""
-        k = (self._k_int.sparse(q)[0] if self._linear is None else self._k_lin).tocoo()
+        k = (self.system.eval_tangent_stiffness(q) if self._linear is None else self._k_lin).tocoo()
         rows, cols, vals = [k.row], [k.col], [k.data]
         e, length, tension = self.dropper_state(q)
         kd = self.dropper_stiffness()
@@ -283,8 +276,8 @@ class CatenaryStructure:
             self._linear = None
             return
         q_ref = np.array(q_ref, dtype=float)
-        f_ref = self._f_int.nonzeros(q_ref)[0]
-        k_ref = self._k_int.sparse(q_ref)[0].tocsr()
+        f_ref = self.system.eval_internal_force(q_ref)
+        k_ref = self.system.eval_tangent_stiffness(q_ref).tocsr()
         self._k_lin = k_ref
         self._linear = lambda q: f_ref - k_ref @ (q - q_ref)
 

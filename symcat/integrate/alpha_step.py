@@ -313,12 +313,13 @@ class StepEquations:
         n_b, n_y = self.bulk.n_b, self.n_y
         if n_b:
             shift = self._rest_values(y, p)[1]
-            data = np.concatenate([data, self.bulk.jacobian.nonzeros(y[:n_b], p, shift[:n_b])[0]])
+            data = np.concatenate([data, self.bulk.jacobian.matrix(y[:n_b], p, shift[:n_b]).data])
         pattern = placement.cache.get("csc")
         if pattern is None:
             rows, cols = placement.jac_rows, placement.jac_cols
             if n_b:
-                bulk_rows, bulk_cols = self.bulk.jacobian.function.sparsity_out(0).get_triplet()
+                bulk = self.bulk.jacobian
+                bulk_rows, bulk_cols = bulk.indices, np.repeat(np.arange(n_b), np.diff(bulk.indptr))
                 rows, cols = np.r_[rows, bulk_rows], np.r_[cols, bulk_cols]
             pattern = placement.cache["csc"] = csc_pattern(rows, cols, n_y)
         place, indices, indptr = pattern

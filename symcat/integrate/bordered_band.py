@@ -163,7 +163,7 @@ def least_band_work(st) -> int:
     n_b = st.bulk.n_b
     if not n_b:
         return 0
-    colind, _ = st.bulk.jacobian.function.sparsity_out(0).get_ccs()
+    colind = st.bulk.jacobian.indptr
     widest = int(np.diff(colind).max(initial=1))
     return n_b * (widest // 2 + 1) ** 2
 
@@ -175,8 +175,8 @@ def step_layout(st, couplings: tuple | None = None) -> BorderedBand:
     n_b, n = st.bulk.n_b, st.n_y
     rows, cols = [], []
     if n_b:
-        b_colind, b_row = st.bulk.jacobian.function.sparsity_out(0).get_ccs()
-        rows += list(b_row)
+        b_colind, b_row = st.bulk.jacobian.indptr, st.bulk.jacobian.indices
+        rows += b_row.tolist()
         cols += np.repeat(np.arange(n_b), np.diff(b_colind)).tolist()
     # the border: its columns whole, its rows over the wires' columns (n (n - n_b) entries,
     # not a test of all n^2 places: a line has tens of thousands of unknowns)

@@ -14,6 +14,7 @@ At 320 km/h with contact loss (9 % of the time on this coarse short line) the di
 (bench/unified_passage.py: 1.4 N rms, 7 N max), which is why this test runs at 200 km/h.
 """
 import numpy as np
+import scipy.sparse as sps
 import pytest
 
 from symcat.analysis.equilibrium import solve_equilibrium
@@ -241,3 +242,43 @@ def test_loaded_catenary_from_warm_starts_is_the_cold_state(form):
     assert np.abs(summed - reference).max() < 1e-8 and np.abs(again - reference_up).max() < 1e-8
     assert np.abs(reference_up - reference).max() > 1e-4  # the forces matter
     form.__dict__.pop("_loaded_states", None)
+
+
+@pytest.mark.parametrize("wires, dropper_damping", [("nonlinear", 0.0), ("linear", 0.0), ("nonlinear", 40.0)])
+def test_assembled_wires_jacobian_is_the_graphs(form, wires, dropper_damping):
+    """The wires' step Jacobian assembled in SciPy (element kernels, droppers' derivatives,
+    mass and Rayleigh matrices: :class:`~symcat.integrate.alpha_bulk.AssembledJacobian`) equals
+    CasADi's derivative of the wires' rows, and its pattern holds the derivative's; with
+    damped droppers (N s/m) their velocity derivative too."""
+    import dataclasses
+
+    import casadi as ca
+
+    if dropper_damping:
+        form = find_form(dataclasses.replace(benchmark2015(SPANS), dropper_damping=dropper_damping), ELEMENTS,
+                         progress=False)
+
+    from symcat.dae.formulation import Formulation
+    from symcat.integrate.alpha_bulk import AssembledJacobian, Bulk, GraphJacobian, bulk_rows
+
+    panto = benchmark2015_pantograph(SPEED_KMH)
+    scene = catenary_scene(form, wires=wires)
+    z = loaded_wire_height(form, X0, float(panto.static_force(SPEED).sum()))
+    add_lumped_pantograph(scene, panto, "contact", X0, SPEED, head_z=z)
+    model = MultibodyModel(scene)
+    fm = Formulation(model, "augmented", "1")
+    n_u = fm.n_f + fm.n_s
+    bulk = Bulk(fm, n_u)
+    assert isinstance(bulk.jacobian, AssembledJacobian)
+    n_b = bulk.n_b
+    y_s, s_s, p_s = ca.MX.sym("y", n_b), ca.MX.sym("s", n_b), ca.MX.sym("p", 3 * n_u + 4)
+    graph = GraphJacobian(ca.Function("j", [y_s, p_s, s_s], [ca.jacobian(bulk_rows(fm, n_b, n_u, y_s, p_s, s_s), y_s)]))
+    rng = np.random.default_rng(5)
+    y = np.asarray(fm.to_internal(model.q0[model.free]))[:n_b] + 1e-3 * rng.standard_normal(n_b)
+    p = np.r_[np.r_[y, np.zeros(n_u - n_b)] + 1e-3 * rng.standard_normal(n_u), rng.standard_normal(2 * n_u),
+              [0.2, 0.25 * 2e-3**2, 0.55 * 2e-3, 0.6]]
+    shift = 1e-4 * rng.standard_normal(n_b)
+    assembled, reference = bulk.jacobian.matrix(y, p, shift), graph.matrix(y, p, shift)
+    assert abs(assembled - reference).max() <= 1e-13 * abs(reference).max()
+    covered = sps.csc_matrix((np.ones(assembled.nnz), assembled.indices, assembled.indptr), shape=assembled.shape)
+    assert covered[reference.nonzero()].min() == 1.0
