@@ -152,12 +152,14 @@ class _StepSystem:
     def extras(self, u: np.ndarray):
         """``C_q`` (dense, free columns), contact gaps (m) and normal forces (N) at ``u``."""
         n_f, n_s, n_sc, n_c = self.sizes
-        if self._extras is None:
-            q, s, sc = ca.MX.sym("q", n_f), ca.MX.sym("s", n_s), ca.MX.sym("sc", n_sc)
-            k = self.form.terms(q, ca.MX.zeros(n_f), s, ca.MX.zeros(n_s), ca.MX(self.t), sc)
-            self._extras = ca.Function("extras", [q, s, sc], [k["Cq"]])
+        if self._extras is None:  # the constraints alone (the whole terms' graph on a line takes long)
+            form = self.form
+            q, s = ca.MX.sym("q", n_f), ca.MX.sym("s", n_s)
+            c = form.model.constraints(form.q_fixed + ca.mtimes(form.P, q), ca.MX.zeros(form.model.n_q), s,
+                                       ca.MX.zeros(n_s), ca.MX(self.t))
+            self._extras = ca.Function("extras", [q, s], [ca.mtimes(c["c_q"], form.P)])
         n_u = n_f + n_s
-        cq = np.asarray(ca.densify(self._extras(u[:n_f], u[n_f:n_u], u[n_u : n_u + n_sc])))
+        cq = np.asarray(ca.densify(self._extras(u[:n_f], u[n_f:n_u])))
         gap, force = self.step.contacts(u[:n_u], np.zeros(n_u), u[n_u : n_u + n_sc], self.t)
         return cq, gap, force
 

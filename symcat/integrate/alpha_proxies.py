@@ -56,12 +56,12 @@ class Proxies:
             picked, used = [], set()
             for sl in items:
                 n_el = len(sl.element_start) - 1
-                ok = [j for j in range(1 + offset, n_el - 1) if np.all(y_of_q[sl.element_indices[j]] >= 0)
-                      and not used & set(sl.element_indices[max(j - 1, 0) : j + 2].ravel().tolist())]
-                if not ok:
+                ok = next((j for j in range(1 + offset, n_el - 1) if np.all(y_of_q[sl.element_indices[j]] >= 0)
+                           and not used & set(sl.element_indices[max(j - 1, 0) : j + 2].ravel().tolist())), None)
+                if ok is None:
                     return None
-                picked.append(ok[0])
-                used |= set(sl.element_indices[ok[0]].tolist())
+                picked.append(ok)
+                used |= set(sl.element_indices[ok].tolist())
             return picked
 
         first, second = candidates(0), candidates(3)

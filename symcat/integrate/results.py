@@ -362,8 +362,12 @@ def joint_reactions(model, cq_free, lam) -> dict:
         Joint name -> (3,) force (N).
     """
     cq_free = np.asarray(cq_free)
-    reaction_map = _ReactionMap(model, ca.Sparsity.dense(*cq_free.shape))
-    forces = reaction_map(cq_free.ravel(order="F")[None, :], np.asarray(lam)[None, :])  # CCS order
+    # its nonzeros only (in CCS order): on a line the dense Jacobian has hundreds of thousands
+    rows, cols = np.nonzero(cq_free)
+    order = np.lexsort((rows, cols))
+    rows, cols = rows[order], cols[order]
+    reaction_map = _ReactionMap(model, ca.Sparsity.triplet(*cq_free.shape, rows.tolist(), cols.tolist()))
+    forces = reaction_map(cq_free[rows, cols][None, :], np.asarray(lam)[None, :])
     return {name: force[0] for name, force in forces.items()}
 
 
