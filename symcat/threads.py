@@ -8,6 +8,7 @@ analysis's dense eigensolver, large, keeps them).
 """
 from __future__ import annotations
 
+import functools
 import sys
 from contextlib import contextmanager
 
@@ -27,3 +28,15 @@ def serial_blas():
         _CONTROLLER[:] = [ThreadpoolController(), len(sys.modules)]
     with _CONTROLLER[0].limit(limits=1, user_api="blas"):
         yield
+
+
+def serially(fn):
+    """``fn`` run with one BLAS thread (:func:`serial_blas`): a solver made of small banded
+    factorizations (form finding, a catenary's static states)."""
+
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        with serial_blas():
+            return fn(*args, **kwargs)
+
+    return wrapper

@@ -27,13 +27,14 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
 from ..analysis.statics import solve_static
+from ..assembly.banded import BandedCholesky
 from ..assembly.system import System
 from ..errors import ParameterError, SolverError
 from ..progress import Status
 from ..scene import NodalForce, Scene
+from ..threads import serially
 from .design import CatenaryDesign
 from .structure import CatenaryStructure
 
@@ -102,6 +103,7 @@ def _balance_axial_forces(body, nodes: np.ndarray, reactions_x: np.ndarray, wire
     body.q0[:] = nodes
 
 
+@serially
 def find_form(design: CatenaryDesign, elements_per_span: int, element: str = "cable3d", tol: float = 1e-8,
               max_iterations: int = 30, progress: bool = True) -> FormFindingResult:
     """Dropper lengths and static equilibrium for ``design`` (see the module docstring);
@@ -251,6 +253,7 @@ def _static_state(st: CatenaryStructure) -> np.ndarray:
     return q
 
 
+@serially
 def coupled_equilibrium(structure: CatenaryStructure, q: np.ndarray, extra=None, rtol: float = 1e-10,
                         max_iterations: int = 40, xtol: float = 1e-8) -> np.ndarray:
     """Static equilibrium of the assembled catenary by Newton's method (tangent with the
@@ -280,7 +283,15 @@ def coupled_equilibrium(structure: CatenaryStructure, q: np.ndarray, extra=None,
             k_extra = extra(q)[1]
             if k_extra is not None:
                 k = k + k_extra
-        dq = spla.spsolve(k[free][:, free].tocsc(), r)
+        factor = BandedCholesky(k[free][:, free], getattr(structure, "_free_permutation", None))
+        structure._free_permutation = factor.permutation  # the pattern changes little: ordered once
+        dq = factor.solve(r)
+        if np.abs(dq).max() < xtol and np.abs(r).max() < 1e-6 * scale:
+            # at the residual's round-off (the wire tensions'): a line search there only
+            # halves steps against noise
+            q = q.copy()
+            q[free] += dq
+            return q
         alpha, norm0 = 1.0, np.linalg.norm(r)
         while True:
             trial = q.copy()

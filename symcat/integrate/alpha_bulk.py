@@ -358,15 +358,15 @@ class _BulkForces:
         picks = np.all(np.diff(p.indptr) == 1) and np.all(p.data == 1.0)
         self._picked = p.indices.copy() if picks else None
         self._q_fixed = np.array(form.q_fixed, float).ravel()
-        q, v = ca.MX.sym("q", self._n_a), ca.MX.sym("v", self._n_a)
         system = model.ancf
         # Linearized wires: one SciPy product (CasADi's sparse product in its virtual machine
         # took five times as long), folded into the step matrix.
         linear = system.affine_forces()
         self.stiffness = self.constant = None
         if linear is None:
-            self._ancf = BufferedFunction(_expanded(ca.Function("alpha_bulk_ancf", [q, v], [ca.densify(
-                system.force_function()(q, v))]), expand))
+            # evaluated in NumPy (the mapped element kernels, scattered): as fast as the
+            # graph's call, without building the graph of the line
+            self._ancf = lambda q_a, v_a: system.eval_internal_force(q_a, v_a) + system.external_force_value(q_a)
         else:
             f_ref, k_ref, q_ref = linear
             to_q = self._to_q[: self._n_a]
@@ -424,7 +424,7 @@ class _BulkForces:
         f = np.zeros(self._n_q)
         if self.stiffness is None:
             # (dense outputs: their nonzeros are the vector, no scatter into a new array)
-            f[: self._n_a] = self._ancf.nonzeros(q[: self._n_a], v[: self._n_a])[0]
+            f[: self._n_a] = self._ancf(q[: self._n_a], v[: self._n_a])
         for fn, flat in self._groups:
             f += np.bincount(flat, fn.nonzeros(q[flat], v[flat], t)[0], minlength=self._n_q)
         return self._to_free @ f
@@ -437,7 +437,7 @@ class _BulkForces:
         for qa, qb, ya, yb in self._runs:
             np.add(q_fixed[qa:qb], y_b[ya:yb], out=q[qa:qb])
             v[qa:qb] = v_b[ya:yb]
-        f_wires = self._ancf.nonzeros(q[: self._n_a], v[: self._n_a])[0]
+        f_wires = self._ancf(q[: self._n_a], v[: self._n_a])
         f = np.empty(y_b.size)
         for qa, qb, ya, yb in self._runs:
             f[ya:yb] = f_wires[qa:qb]
