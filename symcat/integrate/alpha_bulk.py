@@ -51,7 +51,10 @@ class Bulk:
     n_u : int
         Free coordinates and sliding-joint arc lengths (the layout of ``p``).
     expand : bool
-        Expand the bulk's functions to SX when the graph allows it.
+        A few wire elements: the Jacobian as CasADi's derivative of the rows' graph in scalar
+        operations (:class:`GraphJacobian`, the quickest to evaluate), the force elements'
+        functions expanded too. Else the Jacobian is assembled in SciPy
+        (:class:`AssembledJacobian`), with no graph over the line's coordinates to build.
     whole : bool
         Evaluate the residual as one expanded function of ``(y_b, p, shift_b)`` (the wires'
         element forces called as their compiled kernels) instead of in pieces (see
