@@ -241,7 +241,19 @@ class Bulk:
         return out
 
 
-class GraphJacobian:
+class _Pattern:
+    """The CSC pattern ``indptr, indices`` of a Jacobian of shape ``shape``."""
+
+    indptr: np.ndarray
+    indices: np.ndarray
+    shape: tuple
+
+    def sparsity(self) -> ca.Sparsity:
+        """The pattern as CasADi's (for graphs that project onto it)."""
+        return ca.Sparsity(self.shape[0], self.shape[1], self.indptr.tolist(), self.indices.tolist())
+
+
+class GraphJacobian(_Pattern):
     """The bulk's step Jacobian from a CasADi function ``(y_b, p, shift_b) -> J`` (evaluated
     in place on NumPy memory: a call with NumPy arguments converts them to DM and back)."""
 
@@ -257,7 +269,7 @@ class GraphJacobian:
         return sps.csc_matrix((data, self.indices.copy(), self.indptr.copy()), shape=self.shape)
 
 
-class AssembledJacobian:
+class AssembledJacobian(_Pattern):
     """The bulk's step Jacobian ``d r_b / d y_b = c_m M + gamma h D + P_b^T (beta h^2 K +
     gamma h C) P_b`` assembled in SciPy: ``M`` and ``D`` the constant mass and Rayleigh
     matrices on the free coordinates, ``K = -df/dq`` and ``C = -df/dv`` of the wires' element

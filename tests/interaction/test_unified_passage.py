@@ -282,3 +282,4 @@ def test_assembled_wires_jacobian_is_the_graphs(form, wires, dropper_damping):
     assert abs(assembled - reference).max() <= 1e-13 * abs(reference).max()
     covered = sps.csc_matrix((np.ones(assembled.nnz), assembled.indices, assembled.indptr), shape=assembled.shape)
     assert covered[reference.nonzero()].min() == 1.0
+    assert bulk.jacobian.sparsity().get_ccs() == (assembled.indptr.tolist(), assembled.indices.tolist())
