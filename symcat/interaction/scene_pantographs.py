@@ -34,7 +34,10 @@ class ScenePantograph:
         Whether ``add`` places the pantograph in its static equilibrium on the wire loaded by
         the static contact force: the static solve then starts as Newton's method (two
         iterations) instead of a pseudo-transient continuation from rest (ten), which a
-        linkage placed by its geometry alone needs.
+        linkage placed by its geometry alone needs. Such an ``add`` also takes the keyword
+        ``loaded``: the catenary's coordinates in its static state under every pantograph's
+        force, to place it on when several pantographs share the line (each lifts the wire
+        under the others).
     """
 
     add: PantographFragment
@@ -97,9 +100,12 @@ def lumped_fragment(pantograph, contact: str = "penalty", contact_stiffness: flo
 
     from ..pantograph.lumped_scene import add_lumped_pantograph, loaded_wire_height
 
-    def add(scene, wire, x0, speed, uplift):
+    def add(scene, wire, x0, speed, uplift, loaded=None):
+        # loaded: the catenary's static state under every pantograph's force (several
+        # pantographs interact through the wire; placed on it, their trim takes one solve)
         panto = replace(pantograph, uplift=float(uplift))
-        head_z = None if form is None else loaded_wire_height(form, x0, float(panto.static_force(speed).sum()))
+        head_z = None if form is None else loaded_wire_height(form, x0, float(panto.static_force(speed).sum()),
+                                                              state=loaded)
         info = add_lumped_pantograph(scene, panto, wire, x0, speed, contact=contact, contact_stiffness=contact_stiffness,
                                      contact_damping=contact_damping, smoothing=contact_smoothing, head_z=head_z,
                                      name=name)
@@ -189,10 +195,13 @@ def _static(form, pantographs, wire: str, positions, speed: float, uplifts, wire
 
     scene = catenary_scene(form, wires=wires)
     sections = len(form.structure.contacts) > 1
+    loaded = None if load is None else loaded_catenary(form, positions, [load] * len(positions))
     elements = []
     for panto, x0, u in zip(pantographs, positions, uplifts):
         running = running_contact_wire(form, x0) if sections else wire
-        element = contact_element(scene, panto.add(scene, running, x0, speed, float(u)))
+        # a pantograph placed in equilibrium is placed on the wires loaded by all of them
+        extra = {"loaded": loaded} if panto.placed and loaded is not None and len(positions) > 1 else {}
+        element = contact_element(scene, panto.add(scene, running, x0, speed, float(u), **extra))
         if sections:
             if not isinstance(element, PenaltyContact):
                 raise ParameterError(f"pantograph {panto.name}: a sliding joint (bilateral contact) cannot pass the "
@@ -201,8 +210,8 @@ def _static(form, pantographs, wire: str, positions, speed: float, uplifts, wire
             add_section_contacts(form, scene, element, x0)
         elements.append(element)
     model = MultibodyModel(scene)
-    if load is not None:  # the structure's coordinates lead the scene's (catenary_scene)
-        model.q0[: form.structure.n] = loaded_catenary(form, positions, [load] * len(positions))
+    if loaded is not None:  # the structure's coordinates lead the scene's (catenary_scene)
+        model.q0[: form.structure.n] = loaded
     # A pantograph placed in equilibrium on the loaded wires needs no pseudo-inertia (h of 1 s).
     eq = solve_equilibrium(model, pseudo_time_step=1.0 if load is not None and all(p.placed for p in pantographs)
                            else 1e-2)

@@ -177,15 +177,17 @@ def _loaded_start(form, kept: dict, key: tuple) -> np.ndarray:
     return start
 
 
-def loaded_wire_height(form, x: float, force: float, section: int | None = None) -> float:
+def loaded_wire_height(form, x: float, force: float, section: int | None = None, state=None) -> float:
     """Height (m) of the contact wire at ``x`` in the static state of the catenary ``form``
     pressed up by ``force`` (N) at ``x``: what ``CoupledLine._place_pantographs`` solves (the
-    structure's static equilibrium under the point load, :func:`loaded_catenary`)."""
+    structure's static equilibrium under the point load, :func:`loaded_catenary`). ``state``:
+    the catenary's coordinates to read the height from instead (a static state under several
+    pantographs' forces, ``force`` then unused)."""
     from ..interaction.contact import contact_wire_locators
 
     _check_covered(form.structure, [x])
     section = running_sections(form, [x])[0] if section is None else section
-    q = loaded_catenary(form, [x], [force], [section])
+    q = loaded_catenary(form, [x], [force], [section]) if state is None else np.asarray(state, float)
     return contact_wire_locators(form.structure)[section].locate(q, x).height(q)
 
 
