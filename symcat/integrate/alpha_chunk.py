@@ -50,7 +50,7 @@ from .alpha_chunk_residual import ChunkResidual
 from .alpha_integrator import Integrator, State
 from .alpha_newton import SLOW_CONTRACTION
 from .alpha_step import StepEquations, step_sizes
-from .bordered_band import least_band_work, step_layout
+from .bordered_band import step_layout
 
 log = logging.getLogger(__name__)
 
@@ -90,8 +90,8 @@ OPTIMIZED_FLAGS = ("-O3", "-fno-semantic-interposition", "-fPIC", "-shared")
 #: The code the compiled library follows from (this module, the residual, the factorization and
 #: the proxies), part of its cache key.
 _SOURCE = b"".join((Path(__file__).parent / name).read_bytes()
-                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "bordered_band.py", "alpha_proxies.py",
-                                "../codegen/band_c.py"))
+                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "alpha_chunk_wires.py", "bordered_band.py",
+                                "alpha_proxies.py", "../codegen/band_c.py"))
 
 
 class CompiledSteps:
@@ -147,14 +147,9 @@ class CompiledSteps:
         st = self.integ.stepper
         st.scale_multipliers(s.u)  # the scale of the multipliers' tolerance
         try:
-            # the sizes first, a bound before the ordering: a model too large builds nothing more
-            n_r, work = st.n_y - st.bulk.n_b, least_band_work(st)
-            if n_r <= MAX_BORDER and work <= MAX_BAND_WORK:
-                layout = step_layout(st)
-                work = layout.n_b * (layout.bw + 1) ** 2
-            if n_r > MAX_BORDER or work > MAX_BAND_WORK:
-                self.disabled = (f"{n_r} unknowns besides the wires' (at most {MAX_BORDER}), a band "
-                                 f"factorization of {work} operations or more (at most {MAX_BAND_WORK})")
+            n_r = st.n_y - st.bulk.n_b
+            if n_r > MAX_BORDER:  # (the border's Schur complement is dense straight-line code)
+                self.disabled = f"{n_r} unknowns besides the wires' (at most {MAX_BORDER})"
                 return False
             graph = _graph(ChunkResidual(st))
             self._fns, library_key = _compiled(st, self.integ.coef, graph, self.build)
