@@ -81,7 +81,8 @@ class ChunkResidual:
         if expand:
             if not self.looped:
                 self._bulk = merged(self._bulk.expand())
-            self._rest = merged(self._rest.expand())
+            # (its rows sparse: dense, a line's code would write each of its thousands of zeros)
+            self._rest = merged(_sparsified(self._rest.expand()))
             # The rest's border in scalar operations, differentiated where its entries depend
             # on the unknowns: CasADi's derivative of a call in all directions would be the
             # rest's code as many times over as there are directions.
@@ -247,6 +248,12 @@ class ChunkResidual:
         else:
             upper = j_cols[:n_b, :]
         return ca.blockcat([[j_bb, upper], [j_rows, j_cols[n_b:, :]]])
+
+
+def _sparsified(fn: ca.Function) -> ca.Function:
+    """The SX function ``fn`` with its outputs' constant zeros left out of their sparsity."""
+    args = fn.sx_in()
+    return ca.Function(fn.name(), args, [ca.sparsify(out) for out in fn.call(args)], fn.name_in(), fn.name_out())
 
 
 def _scatter_add(values, at, size: int):
