@@ -9,7 +9,7 @@ takes the Python steps and leaves the compiled ones to a background process (thi
 (:func:`symcat.codegen.optimized.compile_waiting`); the model's next runs load the library."""
 from __future__ import annotations
 
-import json
+import os
 import re
 import shutil
 import sys
@@ -41,11 +41,16 @@ def compile_later(functions: list[ca.Function], library: Path, flags: tuple) -> 
     while any background job compiles into the cache (a study of many short runs must not start
     as many compilers; a later run starts the next)."""
     from ..codegen.optimized import failed_path, jobs_running, start_background
-    from ..codegen.paths import atomic_write
 
     if library.exists() or failed_path(library).exists() or jobs_running(library.parent):
         return False
-    atomic_write(_graph_path(library), json.dumps([fn.serialize() for fn in functions]).encode())
+    # one stream: the functions share their parts (each serialized alone repeats them all)
+    graph = _graph_path(library)
+    partial = graph.with_name(f".{graph.name}.{os.getpid()}.tmp")
+    serializer = ca.FileSerializer(str(partial))
+    serializer.pack(functions)
+    del serializer  # (closes the file)
+    os.replace(partial, graph)
     return start_background(library, flags, module=__name__)
 
 
@@ -57,14 +62,12 @@ def _graph_path(library: Path) -> Path:
 def _build_library(library: Path, flags: tuple) -> int:
     """The background job of :func:`compile_later`: the waiting functions' C, then its
     compilation (which removes the lock)."""
-    import os
-
     from ..codegen.optimized import compile_waiting, failed_path, lock_path, source_path
 
     graph = _graph_path(library)
     try:
         os.nice(10)
-        functions = [ca.Function.deserialize(text) for text in json.loads(graph.read_text())]
+        functions = ca.FileDeserializer(str(graph)).unpack()
         with tempfile.TemporaryDirectory() as tmp:
             shutil.move(str(write_c(functions, Path(tmp))), source_path(library))
     except Exception as exc:  # noqa: BLE001 - reported in a file: nobody reads this process's stderr
