@@ -45,8 +45,9 @@ def looped(model) -> bool:
 
 def unloopable(form) -> str | None:
     """Why the wires of ``form`` cannot be built as loops, or None: wire coordinates that are
-    combinations (Cholesky coordinates, not picked ones), or slope moments (forces that depend
-    on the coordinates outside the elements' kernels)."""
+    combinations (Cholesky coordinates, not picked ones), slope moments (forces that depend
+    on the coordinates outside the elements' kernels), or linearized wires whose forces are not
+    affine (element damping: their elastic part is the linearization, not the kernels)."""
     model = form.model
     n_b = int(np.count_nonzero(model.free < model.ancf.n))
     p = to_scipy(form.P).tocsc()[:, :n_b]
@@ -54,6 +55,8 @@ def unloopable(form) -> str | None:
         return "wire coordinates that are combinations of the model's (not picked)"
     if any(isinstance(load, SlopeMoment) for load in model.scene.loads):
         return "slope moments on the wires"
+    if model.scene.linear_wires and model.ancf.affine_forces() is None:
+        return "linearized wires with element damping"
     return None
 
 
