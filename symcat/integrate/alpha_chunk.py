@@ -28,29 +28,33 @@ C and compiled once per model (cached on disk like the models' DAEs,
   steps resume after it.
 
 The results are the Python steps' to the Newton tolerance. Models with wheel/rail contacts
-(events), windows that move without proxy elements, a border of more than :data:`MAX_BORDER`
-unknowns or a band factorization of more than :data:`MAX_BAND_WORK` operations (a line: its
-steps' Python overhead is small against its arithmetic) keep the Python steps."""
+(events), windows that move without proxy elements or a border of more than :data:`MAX_BORDER`
+unknowns keep the Python steps. A line's wires (more than
+:data:`.alpha_chunk_wires.LOOPED_ELEMENTS` elements) are code of loops over their elements
+(:mod:`.alpha_chunk_wires`), whose size does not grow with the line; its optimized library is
+compiled in the background for the model's later runs, the first run stepping in Python
+(:func:`_compiled`)."""
 from __future__ import annotations
 
 import hashlib
 import logging
-import re
 from pathlib import Path
 
 import casadi as ca
 import numpy as np
 
-from ..codegen.band_c import include_in, inputs_by_reference, store_function
-from ..codegen.library import symbolic_kernels, write_functions_c
+from ..codegen.band_c import store_function
+from ..codegen.library import symbolic_kernels
 from ..errors import CompilerError
 from .alpha_bulk import step_data
 from .alpha_chunk_cache import loaded, model_key, read_record, write_record
+from .alpha_chunk_later import compile_later, write_c
 from .alpha_chunk_residual import ChunkResidual
+from .alpha_chunk_wires import looped, unloopable
 from .alpha_integrator import Integrator, State
 from .alpha_newton import SLOW_CONTRACTION
 from .alpha_step import StepEquations, step_sizes
-from .bordered_band import least_band_work, step_layout
+from .bordered_band import step_layout
 
 log = logging.getLogger(__name__)
 
@@ -76,10 +80,6 @@ CONTRACTIONS = (SLOW_CONTRACTION,) * ROUNDS
 BORDER_CONTRACTIONS = (0.7,) * ROUNDS
 #: Unknowns besides the wires' at most (the border's Schur complement is dense).
 MAX_BORDER = 60
-#: Operations of the wires' band factorization at most, ``n_b (b + 1)^2`` (straight-line code:
-#: the compiler's time grows with it; a line's steps keep Python, whose overhead is small
-#: against their arithmetic).
-MAX_BAND_WORK = 60_000
 
 #: The optimized tier's flags (:mod:`symcat.codegen.optimized`; the DAEs use -Og): steps run
 #: millions of times, where -O3's scheduling and vectorization of the wires' long straight-line
@@ -90,8 +90,8 @@ OPTIMIZED_FLAGS = ("-O3", "-fno-semantic-interposition", "-fPIC", "-shared")
 #: The code the compiled library follows from (this module, the residual, the factorization and
 #: the proxies), part of its cache key.
 _SOURCE = b"".join((Path(__file__).parent / name).read_bytes()
-                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "bordered_band.py", "alpha_proxies.py",
-                                "../codegen/band_c.py"))
+                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "alpha_chunk_wires.py",
+                                "alpha_chunk_later.py", "bordered_band.py", "alpha_proxies.py", "../codegen/band_c.py"))
 
 
 class CompiledSteps:
@@ -147,34 +147,38 @@ class CompiledSteps:
         st = self.integ.stepper
         st.scale_multipliers(s.u)  # the scale of the multipliers' tolerance
         try:
-            # the sizes first, a bound before the ordering: a model too large builds nothing more
-            n_r, work = st.n_y - st.bulk.n_b, least_band_work(st)
-            if n_r <= MAX_BORDER and work <= MAX_BAND_WORK:
-                layout = step_layout(st)
-                work = layout.n_b * (layout.bw + 1) ** 2
-            if n_r > MAX_BORDER or work > MAX_BAND_WORK:
-                self.disabled = (f"{n_r} unknowns besides the wires' (at most {MAX_BORDER}), a band "
-                                 f"factorization of {work} operations or more (at most {MAX_BAND_WORK})")
+            n_r = st.n_y - st.bulk.n_b
+            if n_r > MAX_BORDER:  # (the border's Schur complement is dense straight-line code)
+                self.disabled = f"{n_r} unknowns besides the wires' (at most {MAX_BORDER})"
                 return False
-            graph = _graph(ChunkResidual(st))
-            self._fns, library_key = _compiled(st, self.integ.coef, graph, self.build)
+            if looped(st.form.model) and unloopable(st.form) is not None:
+                self.disabled = f"a line whose wires cannot be compiled as loops ({unloopable(st.form)})"
+                return False
+            self._fns, key = _compiled(st, self.integ.coef, self.build)
             if self._fns is None:
-                self.disabled = "not compiled yet, and a short run (see generalized_alpha's compiled)"
+                self.disabled = ("not compiled yet, and a short run or a line (see generalized_alpha's compiled and "
+                                 "_compiled)")
                 return False
         except (RuntimeError, CompilerError) as exc:  # no compiler, or a kernel without SX form
             log.warning("generalized-alpha steps could not be compiled (%s); stepping in Python", exc)
             self.disabled = str(exc)
             return False
-        write_record(self._key, library_key, st.mass_scale)
+        write_record(self._key, key, st.mass_scale)
         self._prepare(st.mass_scale)
         return True
 
     def _load_recorded(self) -> bool:
         """Load the library of the model's record (without the Python step equations); False
         if it is not cached (any more) in the tier this run wants."""
-        from ..codegen.model_dae import existing_library
+        from ..codegen.model_dae import cached_library, existing_library
+        from ..codegen.optimized import optimize_mode
 
-        path = existing_library("alpha_chunk", self._record["library"].encode(), optimized_flags=OPTIMIZED_FLAGS)
+        key = self._record["library"].encode()
+        if looped(self.integ.model) and optimize_mode() == "background":  # a line: its optimized library only
+            path = cached_library("alpha_chunk", key, OPTIMIZED_FLAGS)
+            path = path if path.exists() else None
+        else:
+            path = existing_library("alpha_chunk", key, optimized_flags=OPTIMIZED_FLAGS)
         if path is None:
             return False
         self._fns = loaded(path)
@@ -258,28 +262,36 @@ def unsupported(integ: Integrator, recorded: bool = False) -> str | None:
     return None
 
 
-def _compiled(st: StepEquations, coef, graph: ca.Function, build: bool) -> tuple[dict | None, str]:
+def library_key(st: StepEquations, coef) -> str:
+    """The digest of the compiled steps' library key: the residual over the compiled kernels
+    names the model; the rest of the code follows from this module's source and the settings."""
+    key = _graph(ChunkResidual(st)).serialize().encode() + repr(_settings(st.variant, coef)).encode()
+    return hashlib.sha256(key + b"|alpha_chunk|" + _SOURCE).hexdigest()
+
+
+def _compiled(st: StepEquations, coef, build: bool) -> tuple[dict | None, str]:
     """The compiled functions of :func:`_chunk_functions` by length, from the cache or
     (``build``) generated now (None if not cached and not ``build``), and the digest of the
-    library's key (which names it, for the model's record)."""
-    from ..codegen.model_dae import compiled_library
+    library's key (which names it, for the model's record). A line (wires built as loops,
+    :func:`.alpha_chunk_wires.looped`) under ``$SYMCAT_OPTIMIZE=background`` uses its
+    optimized library only: without one, it is left to a background job for the next runs
+    (:mod:`.alpha_chunk_later`) and this run's steps stay in Python (None)."""
+    from ..codegen.model_dae import cached_library, compiled_library
+    from ..codegen.optimized import optimize_mode
 
-    # The residual over the compiled kernels names the model; the rest of the code follows
-    # from this module's source and the settings.
-    key = graph.serialize().encode() + repr(_settings(st.variant, coef)).encode() + b"|alpha_chunk|" + _SOURCE
-    key = hashlib.sha256(key).hexdigest()
+    key = library_key(st, coef)
+    if looped(st.form.model) and optimize_mode() == "background":
+        library = cached_library("alpha_chunk", key.encode(), OPTIMIZED_FLAGS)
+        if library.exists():
+            return loaded(library), key
+        with symbolic_kernels():
+            functions = _chunk_functions(st, coef)
+        compile_later(functions, library, OPTIMIZED_FLAGS)
+        return None, key
 
     def write(folder):
         with symbolic_kernels():
-            fns = _chunk_functions(st, coef)
-        # the code calls the band's C kernels by name: their source with it; the factor's
-        # memory is read and written where the caller holds it
-        with inputs_by_reference():
-            path = include_in(write_functions_c(fns, "alpha_chunk", folder))
-        size = fns[0].nnz_in(4)
-        if re.search(rf"casadi_copy\(arg\[\d+\], {size}, ", path.read_text()):
-            raise CompilerError(f"the compiled steps' code copies the factor's memory ({size} numbers) it must write")
-        return path
+            return write_c(_chunk_functions(st, coef), folder)
 
     path = compiled_library("alpha_chunk", key.encode(), write, build=build,  # -O0 first, optimized in the background
                             optimized_flags=OPTIMIZED_FLAGS)
@@ -377,52 +389,64 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     iterate = ca.Function("alpha_chunk_iteration", args, [y + dy, err, new_status, count + 1])
     keep = ca.Function("alpha_chunk_keep", args, [y, prev, status, count])
     newton = ca.Function.if_else("alpha_chunk_newton", keep, iterate)
-    # One step: (packed state, factor, token, renew, t0, h, index, n, scale) -> (state, token,
-    # iterations, factorizations); renew: the factor was made at this step's predictor
-    xk, t0, h, index, n = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h"), ca.MX.sym("k"), ca.MX.sym("n")
-    scale = ca.MX.sym("scale", n_y + ROUNDS)  # then per round the contraction that is slow
-    renew = ca.MX.sym("renew")
-    parts = ca.vertsplit(xk, _packed_cuts(n_u, n_c, n_sc))
-    u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev, h_prev, was_failed = parts
-    bh2 = coef.beta * h * h
-    y_k, p_k = predictor(xk, t0, h)
-    active = ca.logic_and(index < n, was_failed == 0)
-    fr = ca.logic_and(active, renew)
-    e, stat, cnt = ca.MX(0), ca.if_else(active, 0, 1), ca.MX(0)  # an inactive step: "converged" untouched
-    tk, factorizations = token, ca.MX(0)
-    for round_ in range(ROUNDS):
-        round_scale = ca.vertcat(scale[:n_y], scale[n_y + round_])
-        for _ in range(MAX_ITERATIONS // ROUNDS):
-            y_k, e, stat, cnt = newton(stat != 0, y_k, e, stat, cnt, fr, p_k, round_scale, factor, tk)
-        wanted = stat == 3
-        if round_ == ROUNDS - 1:
-            continue
-        # slow: the border afresh at the current iterate first, then the whole matrix
-        if border and round_ == 0:
-            tk = refresh_border(wanted, y_k, p_k, factor, tk)
-        else:
-            tk = refresh(wanted, y_k, p_k, factor, tk)
-            fr, factorizations = ca.logic_or(fr, wanted), factorizations + wanted
-        stat, e = ca.if_else(wanted, 0, stat), ca.if_else(wanted, 0, e)
-    ok = ca.logic_and(active, stat == 1)
-    u_pred, v_pred, b, _, _, gh, cm = step_data(p_k, n_u)
-    a_new = (y_k[:n_u] - u_pred - (shift_of(y_k, p_k) if shift_of is not None else 0)) / bh2
-    stepped = ca.vertcat(y_k[:n_u], v_pred + gh * a_new, cm * a_new + b, a_new, y_k[n_u : n_u + n_c] / bh2,
-                         y_k[n_y - n_sc :], a, lam, sc, h, 0)
-    new_x = ca.if_else(ok, stepped, ca.vertcat(xk[:-1], ca.logic_or(was_failed, active)))
-    iterations = ca.if_else(ok, cnt, ca.if_else(active, -1, 0))
-    inputs = [xk, factor, token, renew, t0, h, index, n, scale]
-    step = ca.Function("alpha_chunk_step", inputs, [new_x, tk, iterations, factorizations])
-    skip = ca.Function("alpha_chunk_skip", inputs, [xk, token, 0, 0])
-    step = ca.Function.if_else("alpha_chunk_step_or_skip", step, skip)
+    # One step: (packed state, factor, token, (renew,) t0, h, scale) -> (state, token,
+    # iterations, factorizations); renew: the factor was made at this step's predictor (the
+    # first step's input; the later steps' is 0). A call's arguments are never constants:
+    # CasADi's call of a function on a line's sizes with a constant argument takes tens of
+    # milliseconds, each of the hundreds of calls here.
+    def step_function(first: bool) -> ca.Function:
+        xk, t0, h = ca.MX.sym("x", n_x), ca.MX.sym("t0"), ca.MX.sym("h")
+        scale = ca.MX.sym("scale", n_y + ROUNDS)  # then per round the contraction that is slow
+        renew = ca.MX.sym("renew")
+        parts = ca.vertsplit(xk, _packed_cuts(n_u, n_c, n_sc))
+        u, v, v_dot, a, lam, sc, a_prev, lam_prev, sc_prev, h_prev, was_failed = parts
+        bh2 = coef.beta * h * h
+        y_k, p_k = predictor(xk, t0, h)
+        active = was_failed == 0  # (a step past the call's steps is skipped, see below)
+        fr = ca.logic_and(active, renew) if first else ca.MX(0)
+        e, stat, cnt = ca.MX(0), ca.if_else(active, 0, 1), ca.MX(0)  # an inactive step: "converged" untouched
+        tk, factorizations = token, ca.MX(0)
+        for round_ in range(ROUNDS):
+            round_scale = ca.vertcat(scale[:n_y], scale[n_y + round_])
+            for _ in range(MAX_ITERATIONS // ROUNDS):
+                y_k, e, stat, cnt = newton(stat != 0, y_k, e, stat, cnt, fr, p_k, round_scale, factor, tk)
+            wanted = stat == 3
+            if round_ == ROUNDS - 1:
+                continue
+            # slow: the border afresh at the current iterate first, then the whole matrix
+            if border and round_ == 0:
+                tk = refresh_border(wanted, y_k, p_k, factor, tk)
+            else:
+                tk = refresh(wanted, y_k, p_k, factor, tk)
+                fr, factorizations = ca.logic_or(fr, wanted), factorizations + wanted
+            stat, e = ca.if_else(wanted, 0, stat), ca.if_else(wanted, 0, e)
+        ok = ca.logic_and(active, stat == 1)
+        u_pred, v_pred, b, _, _, gh, cm = step_data(p_k, n_u)
+        a_new = (y_k[:n_u] - u_pred - (shift_of(y_k, p_k) if shift_of is not None else 0)) / bh2
+        stepped = ca.vertcat(y_k[:n_u], v_pred + gh * a_new, cm * a_new + b, a_new, y_k[n_u : n_u + n_c] / bh2,
+                             y_k[n_y - n_sc :], a, lam, sc, h, 0)
+        new_x = ca.if_else(ok, stepped, ca.vertcat(xk[:-1], ca.logic_or(was_failed, active)))
+        iterations = ca.if_else(ok, cnt, ca.if_else(active, -1, 0))
+        inputs = [xk, factor, token] + ([renew] if first else []) + [t0, h, scale]
+        name = "alpha_chunk_step" + ("_first" if first else "")
+        step = ca.Function(name, inputs, [new_x, tk, iterations, factorizations])
+        skip = ca.Function(name + "_skip", inputs, [xk, token, 0, 0])
+        return ca.Function.if_else(name + "_or_skip", step, skip)
+
+    first_step, step = step_function(True), step_function(False)
     # A loop of calls, not mapaccum: its code copies the inputs common to the steps once per
     # step, which cost more than the steps.
     functions = []
+    h, n, renew, scale = ca.MX.sym("h"), ca.MX.sym("n"), ca.MX.sym("renew"), ca.MX.sym("scale", n_y + ROUNDS)
     for per in LENGTHS:
         x0, times = ca.MX.sym("x0", n_x), ca.MX.sym("t", per)
-        x, tk, counts, total = x0, ca.MX(0), [], 0
+        # (the first token: any input, no store precedes the first step)
+        x, tk, counts, total = x0, h, [], 0
         for k in range(per):  # a failed step leaves the state as it was: x is the last good one
-            x, tk, count, fk = step(k < n, x, factor, tk, renew if k == 0 else 0, times[k], h, k, n, scale)
+            if k == 0:
+                x, tk, count, fk = first_step(k < n, x, factor, tk, renew, times[k], h, scale)
+            else:
+                x, tk, count, fk = step(k < n, x, factor, tk, times[k], h, scale)
             counts.append(count)
             total += fk
         functions.append(ca.Function(f"alpha_chunk_{per}", [x0, times, h, n, factor, renew, scale],

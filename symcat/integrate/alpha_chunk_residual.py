@@ -25,6 +25,7 @@ import numpy as np
 from ..assembly.sparse import to_casadi_sparse
 from ..codegen.library import merged
 from .alpha_bulk import bulk_rows, step_data
+from .alpha_chunk_wires import LoopedWires, looped
 from .alpha_proxies import element_terms
 
 #: Operations up to which the wires' Jacobian is expanded to scalar operations (a third faster
@@ -38,9 +39,11 @@ class ChunkResidual:
     """``rows(y, p)``, ``shift(y, p)`` and ``jacobian(y, p)`` of the step of ``st`` (a
     :class:`~.alpha_step.StepEquations`) as MX expressions; ``expand``: the wires' and the
     rest's functions expanded to scalar operations (inside
-    :func:`~symcat.codegen.library.symbolic_kernels`, for the compiled code)."""
+    :func:`~symcat.codegen.library.symbolic_kernels`, for the compiled code), but the wires of
+    a model with many elements (:func:`.alpha_chunk_wires.looped`; ``loops``: whether to,
+    default that), which are built as loops (:class:`.alpha_chunk_wires.LoopedWires`)."""
 
-    def __init__(self, st, expand: bool = False):
+    def __init__(self, st, expand: bool = False, loops: bool | None = None):
         self.st = st
         form = st.form
         self.n_b, self.n_y, self.n_u = n_b, n_y, n_u = st.bulk.n_b, st.n_y, st.n_u
@@ -72,8 +75,14 @@ class ChunkResidual:
         self._rest = ca.Function("alpha_chunk_rest", [y, p, w], [rows, shift])
         self._rest_jacobian = None
         self._expand = expand
+        self.looped = expand and n_b > 0 and (looped(model) if loops is None else loops)
+        if self.looped:  # the wires' code as loops over their elements, not straight-line code
+            self._bulk, self._bulk_jacobian = LoopedWires(st).functions()
         if expand:
-            self._bulk, self._rest = merged(self._bulk.expand()), merged(self._rest.expand())
+            if not self.looped:
+                self._bulk = merged(self._bulk.expand())
+            # (its rows sparse: dense, a line's code would write each of its thousands of zeros)
+            self._rest = merged(_sparsified(self._rest.expand()))
             # The rest's border in scalar operations, differentiated where its entries depend
             # on the unknowns: CasADi's derivative of a call in all directions would be the
             # rest's code as many times over as there are directions.
@@ -239,6 +248,12 @@ class ChunkResidual:
         else:
             upper = j_cols[:n_b, :]
         return ca.blockcat([[j_bb, upper], [j_rows, j_cols[n_b:, :]]])
+
+
+def _sparsified(fn: ca.Function) -> ca.Function:
+    """The SX function ``fn`` with its outputs' constant zeros left out of their sparsity."""
+    args = fn.sx_in()
+    return ca.Function(fn.name(), args, [ca.sparsify(out) for out in fn.call(args)], fn.name_in(), fn.name_out())
 
 
 def _scatter_add(values, at, size: int):

@@ -156,18 +156,6 @@ class BorderedBand:
         return ca.vertcat(z[back.tolist()] if n_b else ca.MX(0, 1), y_r)
 
 
-def least_band_work(st) -> int:
-    """A lower bound of the wires' band factorization's operations, ``n_b (b + 1)^2``, in any
-    ordering: a row of ``k`` entries spans ``k - 1`` columns, so the half-bandwidth is at least
-    ``(k - 1) / 2`` (cheap, unlike the ordering of a line's tens of thousands of unknowns)."""
-    n_b = st.bulk.n_b
-    if not n_b:
-        return 0
-    colind = st.bulk.jacobian.indptr
-    widest = int(np.diff(colind).max(initial=1))
-    return n_b * (widest // 2 + 1) ** 2
-
-
 def step_layout(st, couplings: tuple | None = None) -> BorderedBand:
     """The iteration matrix's :class:`BorderedBand`: the wires' block in the bulk's pattern,
     the rows and columns of the other unknowns dense; of their couplings to the wires only

@@ -48,8 +48,13 @@ def mapped_terms(form: Formulation, light: bool, contacts: bool, compiled: bool 
     the same digest and windows (:func:`~.alpha_chunk_cache.model_memo`): a run's model is built
     anew, and building the function and its map over the outputs cost about as much as the
     compiled steps of a coarse run on a small model. ``compiled``: evaluated by compiled C
-    (:func:`_compiled_terms`) when it can be."""
+    (:func:`_compiled_terms`) when it can be, but not on wires of many elements
+    (:func:`.alpha_chunk_wires.looped`), whose expanded terms are straight-line code over every
+    element (minutes of compiler time and gigabytes of its memory on a line)."""
     from .alpha_chunk_cache import model_memo
+    from .alpha_chunk_wires import looped
+
+    compiled = compiled and not looped(form.model)
 
     def build():
         fn, patterns = _terms_function(form, light, contacts)

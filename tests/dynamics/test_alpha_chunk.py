@@ -301,20 +301,3 @@ def test_a_per_step_monitor_on_compiled_steps(record_property):
     record_property("apart_m", apart)
     assert apart < 1e-6
     assert (compiled > 0).any() and (compiled <= 0).any()
-
-
-def test_the_band_work_bound_is_a_lower_bound_and_refuses_a_long_wire():
-    """The band factorization's operations are bounded from below before any ordering (a line's
-    ordering and layout cost seconds, for steps that then stay in Python): the bound holds on
-    the models the compiled steps take, and a long wire is refused by it."""
-    from symcat.dae.formulation import Formulation
-    from symcat.integrate.alpha_chunk import MAX_BAND_WORK
-    from symcat.integrate.bordered_band import least_band_work, step_layout
-    from symcat.integrate.alpha_integrator import step_equations
-
-    for make in (moving_load, cable_pendulum):
-        st = step_equations(Formulation(make(), "augmented", "1"), "stabilized", compiled=None)
-        layout = step_layout(st)
-        assert 0 < least_band_work(st) <= layout.n_b * (layout.bw + 1) ** 2 <= MAX_BAND_WORK
-    run = generalized_alpha(cable_pendulum(400), 2e-3, 1e-3, n_out=1, progress=False, compiled=True)
-    assert "compiled_steps" not in run.stats
