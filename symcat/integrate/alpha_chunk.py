@@ -99,7 +99,7 @@ class CompiledSteps:
     call (one output interval). The code is generated, or loaded from the cache, at the first
     call; :attr:`disabled` says why a model's steps stay in Python (None: they do not)."""
 
-    def __init__(self, integ: Integrator, h: float, per: int, build: bool = True):
+    def __init__(self, integ: Integrator, h: float, per: int, build: bool | str = True):
         self.integ, self.h, self.per, self.build = integ, h, min(int(per), MAX_STEPS), build
         self._fns = None  # length -> compiled function
         self._factor = None  # the iteration matrix's factor the compiled steps carry (see _prepare)
@@ -269,17 +269,21 @@ def library_key(st: StepEquations, coef) -> str:
     return hashlib.sha256(key + b"|alpha_chunk|" + _SOURCE).hexdigest()
 
 
-def _compiled(st: StepEquations, coef, build: bool) -> tuple[dict | None, str]:
+def _compiled(st: StepEquations, coef, build: bool | str) -> tuple[dict | None, str]:
     """The compiled functions of :func:`_chunk_functions` by length, from the cache or
     (``build``) generated now (None if not cached and not ``build``), and the digest of the
     library's key (which names it, for the model's record). A line (wires built as loops,
     :func:`.alpha_chunk_wires.looped`) under ``$SYMCAT_OPTIMIZE=background`` uses its
     optimized library only: without one, it is left to a background job for the next runs
-    (:mod:`.alpha_chunk_later`) and this run's steps stay in Python (None)."""
+    (:mod:`.alpha_chunk_later`) and this run's steps stay in Python (None). Under ``off`` a
+    line is built (at -O0, slower than its Python steps) only when asked (``build=True``, not
+    ``"long"``: a long run's own choice)."""
     from ..codegen.model_dae import cached_library, compiled_library
     from ..codegen.optimized import optimize_mode
 
     key = library_key(st, coef)
+    if looped(st.form.model) and optimize_mode() == "off" and build is not True:
+        return None, key
     if looped(st.form.model) and optimize_mode() == "background":
         library = cached_library("alpha_chunk", key.encode(), OPTIMIZED_FLAGS)
         if library.exists():
@@ -293,7 +297,7 @@ def _compiled(st: StepEquations, coef, build: bool) -> tuple[dict | None, str]:
         with symbolic_kernels():
             return write_c(_chunk_functions(st, coef), folder)
 
-    path = compiled_library("alpha_chunk", key.encode(), write, build=build,  # -O0 first, optimized in the background
+    path = compiled_library("alpha_chunk", key.encode(), write, build=bool(build),  # -O0 first, optimized in the background
                             optimized_flags=OPTIMIZED_FLAGS)
     if path is None:
         return None, key

@@ -168,9 +168,10 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
     integ = Integrator(model, form, coef, variant, tol, int(max_iterations), max_halvings, expand, stats)
     state = integ.start(x, z, h)
     # The steps run compiled, many per call (a step per call with a per-step monitor); a short
-    # run compiles them only if asked (``compiled=True``), else uses them if cached.
+    # run compiles them only if asked (``compiled=True``), else uses them if cached; a long
+    # one ("long") as its model and $SYMCAT_OPTIMIZE allow (alpha_chunk._compiled).
     chunks = (CompiledSteps(integ, h, per if monitor is None else 1,
-                            build=bool(compiled) or n_steps >= CHUNK_COMPILE_STEPS)
+                            build=True if compiled else "long" if n_steps >= CHUNK_COMPILE_STEPS else False)
               if compiled is not False else None)
     run.multipliers[0] = state.lam
 

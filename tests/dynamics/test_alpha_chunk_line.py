@@ -168,3 +168,21 @@ def _library(model):
     integ = _stepper(model)
     key = alpha_chunk.library_key(integ.stepper, integ.coef)
     return cached_library("alpha_chunk", key.encode(), alpha_chunk.OPTIMIZED_FLAGS)
+
+
+def test_a_long_run_of_a_line_steps_in_python_without_optimization(loops, monkeypatch):
+    """Under ``SYMCAT_OPTIMIZE=off`` a line's long run does not build its steps at -O0 (slower
+    than its Python steps; only ``compiled=True`` asks for them)."""
+    import importlib
+
+    ga = importlib.import_module("symcat.integrate.generalized_alpha")
+    monkeypatch.setenv("SYMCAT_OPTIMIZE", "off")
+    monkeypatch.setattr(ga, "CHUNK_COMPILE_STEPS", 10)
+    built = []
+    monkeypatch.setattr(alpha_chunk, "_chunk_functions", lambda *a: built.append(a) or [])
+    # a library of this model cached by an earlier test or run would be used: none here
+    monkeypatch.setattr(alpha_chunk, "read_record", lambda key: None)
+    monkeypatch.setattr(alpha_chunk, "library_key", lambda st, coef: f"never-cached-{os.getpid()}-{id(st)}")
+    model, _ = line(4)
+    run = generalized_alpha(model, 0.02, 1e-3, 0.8, n_out=2, progress=False, tol=1e-6)
+    assert run.stats["steps"] == 20 and not run.stats.get("compiled_steps") and not built
