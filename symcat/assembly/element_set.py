@@ -111,7 +111,9 @@ class ElementSet:
             fn = self._numeric[name] = BufferedFunction(ca.Function(f"{self.element.name}_{name}_all", states, outputs))
         return fn
 
-    def _pattern(self, name: str, output: int = 0) -> ScatterPattern:
+    def matrix_pattern(self, name: str, output: int = 0) -> ScatterPattern:
+        """Where the element matrices of kernel ``<element>_<name>``'s output ``output``
+        (``"stiffness"``; ``"damping_matrices"`` 0 and 1) land in the global matrix."""
         found = self._patterns.get((name, output))
         if found is None:
             local = self.lib[f"{self.element.name}_{name}"].sparsity_out(output)
@@ -127,11 +129,8 @@ class ElementSet:
         return self._vector(self._kernel("force", 1).outputs(q[self._flat])[0])
 
     def eval_stiffness(self, q: np.ndarray) -> sps.csc_matrix:
-        """:meth:`stiffness` at ``q`` (SciPy CSC, pattern :meth:`stiffness_pattern`)."""
-        return self._pattern("stiffness").csc(self._kernel("stiffness", 1).outputs(q[self._flat])[0])
-
-    def stiffness_pattern(self) -> ScatterPattern:
-        return self._pattern("stiffness")
+        """:meth:`stiffness` at ``q`` (SciPy CSC on ``matrix_pattern("stiffness")``)."""
+        return self.matrix_pattern("stiffness").csc(self._kernel("stiffness", 1).outputs(q[self._flat])[0])
 
     def eval_damping(self, q: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
         """:meth:`damping` at ``(q, q_dot)`` (NumPy)."""
@@ -140,7 +139,7 @@ class ElementSet:
     def eval_damping_matrices(self, q: np.ndarray, q_dot: np.ndarray) -> tuple[sps.csc_matrix, sps.csc_matrix]:
         """:meth:`damping_matrices` at ``(q, q_dot)`` (SciPy CSC)."""
         d, c = self._kernel("damping_matrices", 2).outputs(q[self._flat], q_dot[self._flat])
-        return self._pattern("damping_matrices", 0).csc(d), self._pattern("damping_matrices", 1).csc(c)
+        return self.matrix_pattern("damping_matrices", 0).csc(d), self.matrix_pattern("damping_matrices", 1).csc(c)
 
     # --- constant numeric pieces ------------------------------------------------------------
     def mass_matrix(self) -> sps.csc_matrix:

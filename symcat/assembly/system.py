@@ -250,7 +250,7 @@ class System:
     @cached_property
     def _stiffness_sum(self) -> PatternSum:
         """The element sets' stiffness patterns summed."""
-        return PatternSum([(pt.indptr, pt.indices) for pt in (es.stiffness_pattern() for es in self.element_sets)],
+        return PatternSum([(pt.indptr, pt.indices) for pt in (es.matrix_pattern("stiffness") for es in self.element_sets)],
                           (self.n, self.n))
 
     def eval_force_jacobians(self, q: np.ndarray, q_dot: np.ndarray | None = None, load_factor: float = 1.0):
@@ -290,7 +290,7 @@ class System:
                 for es in self.element_sets:
                     if es.damped:
                         for out, patterns in ((0, k_patterns), (1, c_patterns)):
-                            pt = es._pattern("damping_matrices", out)
+                            pt = es.matrix_pattern("damping_matrices", out)
                             patterns.append((pt.indptr, pt.indices))
             if self._moments:
                 colind, row = self._moment_terms.function.sparsity_out(1).get_ccs()

@@ -283,8 +283,8 @@ def coupled_equilibrium(structure: CatenaryStructure, q: np.ndarray, extra=None,
             k_extra = extra(q)[1]
             if k_extra is not None:
                 k = k + k_extra
-        factor = BandedCholesky(k[free][:, free], getattr(structure, "_free_permutation", None))
-        structure._free_permutation = factor.permutation  # the pattern changes little: ordered once
+        factor = BandedCholesky(k[free][:, free], structure.free_ordering)
+        structure.free_ordering = factor.permutation  # the pattern changes little: ordered once
         dq = factor.solve(r)
         if np.abs(dq).max() < xtol and np.abs(r).max() < 1e-6 * scale:
             # at the residual's round-off (the wire tensions'): a line search there only

@@ -164,6 +164,9 @@ class CatenaryStructure:
         dofs = self.system.dofs
         self.n = dofs.n
         self.free = dofs.free
+        # a fill-reducing ordering of the free stiffness, kept by the static solves that
+        # factorize it (its pattern changes only with the droppers' slackness)
+        self.free_ordering = None
         idx = lambda body, c: np.array([dofs.index(body, k, c) for k in range(body.n_nodes)], dtype=np.int64)
         self.cw_xyz = np.concatenate([np.stack([idx(b, c) for c in "xyz"], axis=1) for b in self.contacts])
         self.mw_xyz = np.concatenate([np.stack([idx(b, c) for c in "xyz"], axis=1) for b in self.messengers])
