@@ -247,7 +247,7 @@ def test_loaded_catenary_from_warm_starts_is_the_cold_state(form):
 @pytest.mark.parametrize("wires, dropper_damping", [("nonlinear", 0.0), ("linear", 0.0), ("nonlinear", 40.0)])
 def test_assembled_wires_jacobian_is_the_graphs(form, wires, dropper_damping):
     """The wires' step Jacobian assembled in SciPy (element kernels, droppers' derivatives,
-    mass and Rayleigh matrices: :class:`~symcat.integrate.alpha_bulk.AssembledJacobian`) equals
+    mass and Rayleigh matrices: :class:`~symcat.integrate.alpha_bulk_jacobian.AssembledJacobian`) equals
     CasADi's derivative of the wires' rows, and its pattern holds the derivative's; with
     damped droppers (N s/m) their velocity derivative too."""
     import dataclasses
@@ -259,7 +259,8 @@ def test_assembled_wires_jacobian_is_the_graphs(form, wires, dropper_damping):
                          progress=False)
 
     from symcat.dae.formulation import Formulation
-    from symcat.integrate.alpha_bulk import AssembledJacobian, Bulk, GraphJacobian, bulk_rows
+    from symcat.integrate.alpha_bulk import Bulk, bulk_rows
+    from symcat.integrate.alpha_bulk_jacobian import AssembledJacobian, GraphJacobian
 
     panto = benchmark2015_pantograph(SPEED_KMH)
     scene = catenary_scene(form, wires=wires)
