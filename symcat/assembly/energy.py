@@ -123,9 +123,32 @@ class _ContactEnergy:
             self.contacts.append((ct, np.array(model._rigid_indices(ct.body.name)), built[ct.library],
                                   ct.params[names.index("k")], ct.params[names.index("delta")]))
 
-    def __call__(self, q, v, sc) -> tuple[float, float]:
-        """Potential (J) and non-conservative power (W) of all contacts."""
-        energy = power = 0.0
+    def powers(self, q, v, sc) -> np.ndarray:
+        """The non-conservative power (W) of all contacts at the states of the rows of ``q``,
+        ``v`` and ``sc`` (the states after several steps: each contact's terms evaluated for
+        all of them in one call)."""
+        k = len(q)
+        power = np.zeros(k)
+        for i, (ct, rigid, terms, kk, delta) in enumerate(self.contacts):
+            starts, s = np.asarray(ct.element_start), sc[:, i]
+            on = (starts[0] <= s) & (s <= starts[-1])  # off its wire: no force (contact_terms)
+            if not on.any():
+                continue
+            e = np.clip(np.searchsorted(starts, s[on], side="right") - 1, 0, len(starts) - 2)
+            rows = np.asarray(ct.element_indices)[e]  # (k_on, n_local)
+            q_on, v_on = q[on], v[on]
+            y = np.concatenate((np.take_along_axis(q_on, rows, 1), q_on[:, rigid], (s[on] - starts[e])[:, None]), 1)
+            y_dot = np.concatenate((np.take_along_axis(v_on, rows, 1), v_on[:, rigid]), 1)
+            p = np.tile(ct.params, (len(e), 1))
+            p[:, 0] = starts[e + 1] - starts[e]
+            q_v, gap, pen_dot = _mapped(terms, len(e)).nonzeros(y.ravel(), y_dot.ravel(), p.ravel())
+            f_el = np.array([_penalty_scalar(-g, kk, delta)[1] for g in gap])
+            power[on] += q_v + f_el * pen_dot
+        return power
+
+    def potential(self, q, v, sc) -> float:
+        """The potential (J) of all contacts at the state ``(q, v, sc)``."""
+        energy = 0.0
         for (ct, rigid, terms, k, delta), s in zip(self.contacts, sc):
             starts = ct.element_start
             if not starts[0] <= s <= starts[-1]:
@@ -133,14 +156,22 @@ class _ContactEnergy:
             e = min(max(int(np.searchsorted(starts, s, side="right")) - 1, 0), len(starts) - 2)
             rows = ct.element_indices[e]
             y = np.concatenate((q[rows], q[rigid], (s - starts[e],)))
-            y_dot = np.concatenate((v[rows], v[rigid]))
             p = ct.params.copy()
             p[0] = starts[e + 1] - starts[e]
-            q_v, gap, pen_dot = (float(x[0]) for x in terms.nonzeros(y, y_dot, p))
-            v_el, f_el = _penalty_scalar(-gap, k, delta)
-            energy += v_el
-            power += q_v + f_el * pen_dot
-        return energy, power
+            gap = float(terms.nonzeros(y, np.concatenate((v[rows], v[rigid])), p)[1][0])
+            energy += _penalty_scalar(-gap, k, delta)[0]
+        return energy
+
+
+_MAPPED: dict = {}
+
+
+def _mapped(fn: BufferedFunction, k: int) -> BufferedFunction:
+    """``fn`` mapped over ``k`` columns (kept per function and ``k``)."""
+    key = (id(fn), k)
+    if key not in _MAPPED:
+        _MAPPED[key] = (fn, BufferedFunction(fn.function.map(k)))  # (fn kept: its id stays its own)
+    return _MAPPED[key][1]
 
 
 def _penalty_scalar(u: float, k: float, d: float) -> tuple[float, float]:
@@ -221,7 +252,7 @@ class EnergyTerms:
         the model's, ``model.coordinate_names()``) and contact arc lengths ``sc`` (m)."""
         sc = np.zeros(0) if sc is None else sc
         kinetic, potential = self._energy.nonzeros(q, v)
-        contact = self._contacts(q, v, sc)[0] if self._contacts is not None else 0.0
+        contact = self._contacts.potential(q, v, sc) if self._contacts is not None else 0.0
         return float(kinetic[0]), float(potential[0]) + contact
 
     def power(self, q: np.ndarray, v: np.ndarray, sc: np.ndarray | None, multipliers: np.ndarray,
@@ -230,17 +261,26 @@ class EnergyTerms:
         model's constraint rows) and time ``t``: of the constraint forces (the prescribed
         motions' driving) and of the non-conservative forces (dampers, time-varying loads,
         Rayleigh damping; <= 0 when they only dissipate)."""
-        sc = np.zeros(0) if sc is None else sc
-        other = float(self._power.nonzeros(q, v, t)[0][0])
+        sc = np.zeros(0) if sc is None else np.asarray(sc)
+        driving, other = self.powers(q[None], v[None], sc[None], np.asarray(multipliers)[None], np.array([t]))
+        return float(driving[0]), float(other[0])
+
+    def powers(self, q: np.ndarray, v: np.ndarray, sc: np.ndarray, multipliers: np.ndarray,
+               t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`power` at several states (a monitor's, after consecutive steps): each
+        argument's first axis the states (``t`` (k,)); the two work rates (W), (k,) each."""
+        k = len(t)
+        other = np.array([self._power.nonzeros(q[i], v[i], t[i])[0][0] for i in range(k)])
         if self._contacts is not None:
-            other += self._contacts(q, v, sc)[1]
-        if self._rayleigh is not None:
+            other += self._contacts.powers(q, v, sc)
+        if self._rayleigh is not None:  # v C v of each state: one product for all
             upper, diagonal = self._rayleigh
-            other -= float(2.0 * (v @ (upper @ v)) + v @ (diagonal * v))
-        driving = 0.0
+            other -= 2.0 * np.einsum("ij,ji->i", v, upper @ v.T) + np.einsum("ij,ij->i", v * diagonal, v)
+        driving = np.zeros(k)
         if self._ct is not None:
-            c_t = self._ct.nonzeros(q, t)[0]
-            driving = float(np.asarray(multipliers)[: c_t.size] @ c_t)
+            for i in range(k):
+                c_t = self._ct.nonzeros(q[i], t[i])[0]
+                driving[i] = np.asarray(multipliers[i])[: c_t.size] @ c_t
         return driving, other
 
 

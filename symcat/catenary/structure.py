@@ -219,14 +219,15 @@ class CatenaryStructure:
         return np.full(self.dropper_length.shape, d.dropper_stiffness) if d.dropper_stiffness > 0 else d.dropper_EA / self.dropper_length
 
     def dropper_state(self, q: np.ndarray, v: np.ndarray | None = None):
-        """Unit vectors CW -> MW, current lengths (m) and tensions (N, >= 0) of the droppers."""
+        """Unit vectors CW -> MW, current lengths (m) and tensions (N, >= 0) of the droppers
+        (of the states of ``q``'s, and ``v``'s, leading axes: each row a state)."""
         ia, ib = self.cw_xyz[self.dropper_nodes], self.mw_xyz[self.dropper_nodes]
-        delta = q[ib] - q[ia]
-        length = np.linalg.norm(delta, axis=1)
-        e = delta / length[:, None]
+        delta = q[..., ib] - q[..., ia]
+        length = np.linalg.norm(delta, axis=-1)
+        e = delta / length[..., None]
         tension = self.dropper_stiffness() * (length - self.dropper_length)
         if v is not None and self.design.dropper_damping > 0:
-            rate = np.einsum("ij,ij->i", e, v[ib] - v[ia])
+            rate = np.einsum("...ij,...ij->...i", e, v[..., ib] - v[..., ia])
             tension = np.where(tension > 0, tension + self.design.dropper_damping * rate, tension)
         return e, length, np.maximum(tension, 0.0)
 

@@ -1,5 +1,6 @@
 """Generalized-alpha steps run in compiled C, many per call: the plain steps of a run without
-events or per-step monitor (:func:`.generalized_alpha.integrate_alpha`).
+events (:func:`.generalized_alpha.integrate_alpha`), recording each step's state for a run's
+per-step monitor.
 
 Why: on a small model (a cable pendulum of a hundred coordinates, a wire under a moving load)
 a step's arithmetic takes tens of microseconds, and the Python around each Newton iteration
@@ -113,14 +114,15 @@ class CompiledSteps:
         self._record = read_record(self._key)
         self.disabled = unsupported(integ, self._record is not None)
 
-    def advance(self, s: State, t0: float, n: int) -> State:
-        """The state ``n`` steps of :attr:`h` after ``s`` at ``t0``."""
+    def advance(self, s: State, t0: float, n: int, states: list | None = None) -> State:
+        """The state ``n`` steps of :attr:`h` after ``s`` at ``t0``; with ``states`` (a list),
+        the :class:`~.alpha_run.StepStates` after each step appended to it (a monitored run)."""
         integ, h = self.integ, self.h
         k = 0
         while k < n:
             renew = self._renew
             if self.disabled is None and self._ready(s, t0 + k * h):
-                done, s, iterations = self._call(s, t0 + k * h, n - k)
+                done, s, iterations = self._call(s, t0 + k * h, n - k, states)
                 integ.stats["steps"] += done
                 integ.stats["compiled_steps"] = integ.stats.get("compiled_steps", 0) + done
                 integ.stats["newton_iterations"] += iterations
@@ -135,6 +137,8 @@ class CompiledSteps:
                 s = integ.advance(s, t0 + k * h, h)
                 self._renew = True
                 k += 1
+                if states is not None:
+                    states.append(integ.step_state(s, t0 + k * h))
         integ.stats["nsteps"] = integ.stats["steps"]
         return s
 
@@ -199,12 +203,12 @@ class CompiledSteps:
         self._scale = np.r_[np.full(n_y, self.integ.tol), BORDER_CONTRACTIONS if border else CONTRACTIONS]
         self._scale[n_u : n_u + n_c] *= mass_scale
 
-    def _call(self, s: State, t: float, n: int):
+    def _call(self, s: State, t: float, n: int, states: list | None = None):
         """``(steps done, state after them, Newton iterations)`` of one compiled call of at most
-        ``min(n, per)`` steps from ``s`` at ``t``."""
+        ``min(n, per)`` steps from ``s`` at ``t`` (``states``: see :meth:`advance`)."""
         per, h = self.per, self.h
         length = next(L for L in LENGTHS if L >= min(n, per))
-        fn, factor = self._fns[length], self._factor
+        fn, factor = self._fns[f"recorded_{length}" if states is not None else length], self._factor
         last = self._last  # (the state the last call gave, packed): the next call's input as it is
         packed = last[1] if last is not None and last[0] is s else self._pack(s)
         if self._renew:  # the matrix afresh at the first step's predictor
@@ -213,16 +217,27 @@ class CompiledSteps:
             renew.outputs(packed, t, h)
             self.integ.compiled_factorizations += 1
         fn.bind({4: factor})  # read and renewed in place: after the call, the factor the steps ended with
-        x, its, factorizations = fn.outputs(
+        x, its, factorizations, *records = fn.outputs(
             packed, t + h * np.arange(length), h, min(n, per), factor, float(self._renew), self._scale)
         its = its.copy()
         self.integ.compiled_factorizations += int(factorizations[0])
         done = min(int(np.argmin(its > 0)) if its.min() <= 0 else length, n, per)
         self._renew = done < min(n, per)  # a failure: renew the matrix where the next call starts
         if done:
+            if states is not None:
+                states.append(self._states(records[0], t, done))
             s, x = self._unpack(x)
             self._last = (s, x)
         return done, s, int(its[:done].sum())
+
+    def _states(self, records: np.ndarray, t: float, done: int):
+        """The :class:`~.alpha_run.StepStates` of the first ``done`` steps' ``records`` (a
+        call's output, one column per step) of a call from ``t``."""
+        n_u, n_c, n_sc, _ = step_sizes(self.integ.form, self.integ.variant)
+        r = records.reshape(-1, record_size(n_u, n_c, n_sc))[:done]
+        cuts = np.cumsum([0, n_u, n_u, n_u, n_c, n_sc, n_sc, n_sc])
+        parts = [r[:, i:j] for i, j in zip(cuts[:-1], cuts[1:])]
+        return self.integ.step_states(t + self.h * np.arange(1, done + 1), *parts)
 
     # --- the packed state: u v v_dot a lam sc a_prev lam_prev sc_prev h failed --------------
     def _pack(self, s: State) -> np.ndarray:
@@ -320,7 +335,10 @@ def _chunk_functions(st: StepEquations, coef) -> list:
     in place (:func:`~symcat.codegen.band_c.store_function`): after the call it holds the
     factor the steps ended with, the next call's. Then ``alpha_chunk_renew(x0, t0, h) ->
     factor``: the matrix at the predictor of the step from ``x0`` at ``t0``, which the caller
-    runs, into the same memory, before a call that renews it."""
+    runs, into the same memory, before a call that renews it. ``alpha_chunk_recorded_<per>``:
+    the same with a fourth output, each step's record (:func:`_record_function`, one column per
+    step), for a monitored run (its own functions: the records cost a copy of the state per
+    step, which an unmonitored run does not pay)."""
     n_u, n_c, n_sc, n_y = st.n_u, st.n_c, st.n_sc, st.n_y
     n_x = 5 * n_u + 2 * (n_c + n_sc) + 2
     y, p = ca.MX.sym("y", n_y), ca.MX.sym("p", 3 * n_u + 4)
@@ -438,24 +456,50 @@ def _chunk_functions(st: StepEquations, coef) -> list:
         return ca.Function.if_else(name + "_or_skip", step, skip)
 
     first_step, step = step_function(True), step_function(False)
+    record = _record_function(residual, n_u, n_c, n_sc, n_y)
     # A loop of calls, not mapaccum: its code copies the inputs common to the steps once per
     # step, which cost more than the steps.
     functions = []
     h, n, renew, scale = ca.MX.sym("h"), ca.MX.sym("n"), ca.MX.sym("renew"), ca.MX.sym("scale", n_y + ROUNDS)
-    for per in LENGTHS:
-        x0, times = ca.MX.sym("x0", n_x), ca.MX.sym("t", per)
-        # (the first token: any input, no store precedes the first step)
-        x, tk, counts, total = x0, h, [], 0
-        for k in range(per):  # a failed step leaves the state as it was: x is the last good one
-            if k == 0:
-                x, tk, count, fk = first_step(k < n, x, factor, tk, renew, times[k], h, scale)
-            else:
-                x, tk, count, fk = step(k < n, x, factor, tk, times[k], h, scale)
-            counts.append(count)
-            total += fk
-        functions.append(ca.Function(f"alpha_chunk_{per}", [x0, times, h, n, factor, renew, scale],
-                                     [x, ca.vertcat(*counts), total]))
+    for recorded in (False, True):
+        for per in LENGTHS:
+            x0, times = ca.MX.sym("x0", n_x), ca.MX.sym("t", per)
+            # (the first token: any input, no store precedes the first step)
+            x, tk, counts, total, records = x0, h, [], 0, []
+            for k in range(per):  # a failed step leaves the state as it was: x is the last good one
+                if k == 0:
+                    x, tk, count, fk = first_step(k < n, x, factor, tk, renew, times[k], h, scale)
+                else:
+                    x, tk, count, fk = step(k < n, x, factor, tk, times[k], h, scale)
+                counts.append(count)
+                total += fk
+                if recorded:
+                    records.append(record(x, times[k] + h))
+            outputs = [x, ca.vertcat(*counts), total] + ([ca.horzcat(*records)] if recorded else [])
+            name = f"alpha_chunk_{'recorded_' if recorded else ''}{per}"
+            functions.append(ca.Function(name, [x0, times, h, n, factor, renew, scale], outputs))
     return functions + [renew_matrix]
+
+
+def _record_function(residual: ChunkResidual, n_u: int, n_c: int, n_sc: int, n_y: int) -> ca.Function:
+    """``alpha_chunk_record(x, t) -> [u, v, v_dot, lam, sc, gap, force]``: what a monitored
+    run records of the packed state ``x`` at time ``t`` (:meth:`CompiledSteps.advance`), the
+    penalty contacts' gaps and forces as :meth:`.alpha_step.StepEquations.contacts` has them
+    (the rest at ``y = [u, 0, sc]``, step data whose velocity is ``v``)."""
+    x, t = ca.MX.sym("x", 5 * n_u + 2 * (n_c + n_sc) + 2), ca.MX.sym("t")
+    u, v, v_dot, _, lam, sc = ca.vertsplit(x, _packed_cuts(n_u, n_c, n_sc))[:6]
+    contacts = []
+    if n_sc:
+        # (dense: the proxies pick their elements from them by parametric indices)
+        y = ca.vertcat(u, ca.MX.zeros(n_y - n_u - n_sc, 1), sc)
+        p = ca.vertcat(u, v, ca.MX.zeros(n_u, 1), t, 1, 1, 1)
+        contacts = [ca.densify(c) for c in residual.contacts(y, p)]
+    return ca.Function("alpha_chunk_record", [x, t], [ca.densify(ca.vertcat(u, v, v_dot, lam, sc, *contacts))])
+
+
+def record_size(n_u: int, n_c: int, n_sc: int) -> int:
+    """Numbers a compiled step records per step (:func:`_record_function`)."""
+    return 3 * n_u + n_c + 3 * n_sc
 
 
 def _nonzeros(m: ca.MX) -> ca.MX:

@@ -67,12 +67,14 @@ class ChunkResidual:
             else:  # windows that never move: each is its whole wire
                 for sl in items:
                     sl.window = (0, len(sl.element_start) - 1)
-            rows, shift = st._rows(y, p, ca.MX.sym("mode", 0), part="rest")
+            rows, shift, *contacts = st._rows(y, p, ca.MX.sym("mode", 0), contacts=bool(st.n_sc), part="rest")
         finally:
             model.element_override.clear()
             for sl, window in zip(items, saved):
                 sl.window = window
         self._rest = ca.Function("alpha_chunk_rest", [y, p, w], [rows, shift])
+        # the penalty contacts' gaps and forces, for the records of a monitored run
+        self._contacts = ca.Function("alpha_chunk_contacts", [y, p, w], contacts) if contacts else None
         self._rest_jacobian = None
         self._expand = expand
         self.looped = expand and n_b > 0 and (looped(model) if loops is None else loops)
@@ -83,6 +85,8 @@ class ChunkResidual:
                 self._bulk = merged(self._bulk.expand())
             # (its rows sparse: dense, a line's code would write each of its thousands of zeros)
             self._rest = merged(_sparsified(self._rest.expand()))
+            if self._contacts is not None:
+                self._contacts = merged(self._contacts.expand())
             # The rest's border in scalar operations, differentiated where its entries depend
             # on the unknowns: CasADi's derivative of a call in all directions would be the
             # rest's code as many times over as there are directions.
@@ -192,6 +196,14 @@ class ChunkResidual:
         y_sub, p_sub, w, terms = self._substituted(y, p)
         rows, shift = self._rest(y_sub, p_sub, w)
         return self._moved_back(rows, terms), self._moved_back(shift, terms)
+
+    def contacts(self, y, p):
+        """The penalty contacts' gaps (m) and normal forces (N) at ``(y, p)`` (on the proxies'
+        actual elements), as :meth:`.alpha_step.StepEquations.contacts` evaluates them."""
+        if self.proxies is None:
+            return self._contacts(y, p, ca.MX(0, 1))
+        y_sub, p_sub, w, _ = self._substituted(y, p)
+        return self._contacts(y_sub, p_sub, w)
 
     def rows_and_shift(self, y, p):
         """The step's residual rows and the stabilization's shift ``G^T nu`` at ``(y, p)``."""

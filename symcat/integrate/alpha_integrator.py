@@ -14,7 +14,7 @@ import scipy.sparse.linalg as spla
 from ..dae.formulation import Formulation
 from ..dae.initial import consistent_state
 from ..errors import SolverError
-from .alpha_run import StepState
+from .alpha_run import StepStates
 from .alpha_newton import solve_step
 from .alpha_step import StepEquations
 from .simulate import update_windows
@@ -192,16 +192,23 @@ class Integrator:
         self.stats["rebuilds"] += 1
         return True
 
-    def step_state(self, s: State, t: float) -> StepState:
-        """The :class:`StepState` of ``s`` at time ``t`` (physical, all coordinates)."""
-        model, form = self.model, self.form
-        n_f = form.n_f
-        q, v, a = model.q0.copy(), np.zeros(model.n_q), np.zeros(model.n_q)
-        q[model.free] = form.to_physical(s.u[:n_f])
-        v[model.free] = form.to_physical(s.v[:n_f])
-        a[model.free] = form.to_physical(s.v_dot[:n_f])
+    def step_state(self, s: State, t: float) -> StepStates:
+        """The :class:`StepStates` (one) of ``s`` at time ``t`` (physical, all coordinates)."""
         gap, force = self.stepper.contacts(s.u, s.v, s.sc, t)
-        return StepState(t, q, v, a, s.u[n_f:].copy(), s.lam.copy(), s.sc.copy(), gap, force)
+        return self.step_states(np.array([t]), s.u[None], s.v[None], s.v_dot[None], s.lam[None], s.sc[None],
+                                gap[None], force[None])
+
+    def step_states(self, t, u, v, v_dot, lam, sc, gap, force) -> StepStates:
+        """The :class:`StepStates` of the step unknowns' values after consecutive steps (each
+        array's first axis the steps, as the compiled steps record them)."""
+        model, form = self.model, self.form
+        n_f, k = form.n_f, len(t)
+        q, vel, acc = np.tile(model.q0, (k, 1)), np.zeros((k, model.n_q)), np.zeros((k, model.n_q))
+        q[:, model.free] = form.to_physical(u[:, :n_f].T).T
+        vel[:, model.free] = form.to_physical(v[:, :n_f].T).T
+        acc[:, model.free] = form.to_physical(v_dot[:, :n_f].T).T
+        return StepStates(np.asarray(t, float), q, vel, acc, u[:, n_f:].copy(), lam.copy(), sc.copy(), gap.copy(),
+                          force.copy())
 
     def layout(self, s: State):
         """The state in the augmented index-1 layout ``x = [q, s, v, w]``, ``z = [a, s_dd, lambda(, sc)]``."""

@@ -1,6 +1,6 @@
 """What a generalized-alpha run hands back (:mod:`.generalized_alpha`): the outputs of a run
 (:class:`AlphaRun`, turned into the :class:`~.results.SimulationResult` every integrator gives)
-and the state a per-step ``monitor`` sees (:class:`StepState`)."""
+and the states a per-step ``monitor`` sees (:class:`StepStates`)."""
 from __future__ import annotations
 
 import time
@@ -59,19 +59,22 @@ class AlphaRun:
         # a run whose steps were compiled has its terms compiled too (seconds once per model)
         res = collect_result(self.form, self.t_s[:n], self.xs, self.zs, self.stats, wall0, modes, self.events,
                              self.walls, given, compiled=self.stats.get("compiled_steps", 0) > 0)
-        res.monitored = {key: np.asarray(values) for key, values in self.monitored.items()}
+        res.monitored = {key: np.concatenate(values) for key, values in self.monitored.items()}
         return res
 
 
 @dataclass
-class StepState:
-    """What a ``monitor`` of :func:`generalized_alpha` sees after each step (SI units): time
-    ``t_s``, all coordinates ``q``, velocities ``v`` and accelerations ``a`` (fixed ones
-    included, ``model.coordinate_names()``), the sliding-joint arc lengths ``s_m``, the
-    integrator's multipliers, and per penalty contact (``model.contacts``) the arc length
-    ``sc_m``, normal gap ``gap_m`` (> 0 separated) and normal force ``force_N``."""
+class StepStates:
+    """What a ``monitor`` of :func:`generalized_alpha` sees: the states after consecutive steps
+    (SI units), each array's first axis the steps: times ``t_s`` (k,), all coordinates ``q``,
+    velocities ``v`` and accelerations ``a`` (k, n_q: fixed ones included,
+    ``model.coordinate_names()``), the sliding-joint arc lengths ``s_m``, the integrator's
+    multipliers, and per penalty contact (``model.contacts``) the arc length ``sc_m``, normal
+    gap ``gap_m`` (> 0 separated) and normal force ``force_N``. A batch, not one state: the
+    compiled steps hand over the states of all the steps of a call at once, and a monitor
+    evaluated over them as arrays costs a fraction of one called per step."""
 
-    t_s: float
+    t_s: np.ndarray
     q: np.ndarray
     v: np.ndarray
     a: np.ndarray
@@ -80,3 +83,13 @@ class StepState:
     sc_m: np.ndarray
     gap_m: np.ndarray
     force_N: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.t_s)
+
+    @classmethod
+    def stacked(cls, parts: list["StepStates"]) -> "StepStates":
+        """The states of ``parts`` (consecutive batches) as one batch."""
+        if len(parts) == 1:
+            return parts[0]
+        return cls(*(np.concatenate([getattr(p, name) for p in parts]) for name in cls.__dataclass_fields__))

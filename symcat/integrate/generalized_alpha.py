@@ -90,7 +90,7 @@ from .alpha_chunk import CompiledSteps
 from .alpha_coefficients import AlphaCoefficients
 from .alpha_events import integrate_alpha_events
 from .alpha_integrator import Integrator, StepFailure
-from .alpha_run import AlphaRun
+from .alpha_run import AlphaRun, StepStates
 from .results import SimulationResult
 from .simulate import one_handler
 
@@ -167,10 +167,10 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
                  dt=h, rho_inf=coef.rho_inf, variant=variant)
     integ = Integrator(model, form, coef, variant, tol, int(max_iterations), max_halvings, expand, stats)
     state = integ.start(x, z, h)
-    # The steps run compiled, many per call (a step per call with a per-step monitor); a short
-    # run compiles them only if asked (``compiled=True``), else uses them if cached; a long
-    # one ("long") as its model and $SYMCAT_OPTIMIZE allow (alpha_chunk._compiled).
-    chunks = (CompiledSteps(integ, h, per if monitor is None else 1,
+    # The steps run compiled, many per call (recording each step's state for a monitor); a
+    # short run compiles them only if asked (``compiled=True``), else uses them if cached; a
+    # long one ("long") as its model and $SYMCAT_OPTIMIZE allow (alpha_chunk._compiled).
+    chunks = (CompiledSteps(integ, h, per,
                             build=True if compiled else "long" if n_steps >= CHUNK_COMPILE_STEPS else False)
               if compiled is not False else None)
     run.multipliers[0] = state.lam
@@ -181,30 +181,37 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
 
     contacts(0.0)
 
-    def record(t):
+    def record(states: list):
+        """The monitor's values of the states after some steps (one call, all of them)."""
         if monitor is None:
             return
-        values = monitor(integ.step_state(state, t))
-        run.monitored.setdefault("t_s", []).append(t)
+        batch = StepStates.stacked(states)
+        values = monitor(batch)
+        run.monitored.setdefault("t_s", []).append(batch.t_s)
         for key, value in values.items():
+            if len(value) != len(batch):
+                raise ValueError(f"monitor: its value {key!r} has {len(value)} entries for {len(batch)} steps (the "
+                                 "monitor gets the states of several steps, its values one entry per step)")
             run.monitored.setdefault(key, []).append(value)
 
-    record(0.0)
+    record([integ.step_state(state, 0.0)])
     bar = Progress("generalized-alpha", t_end, "s", enabled=progress)
     step = 0
     try:
         with integrating():
             for out in range(1, n_outputs + 1):
                 try:
-                    if chunks is not None and monitor is None:
-                        state = chunks.advance(state, step * h, per)
+                    states = None if monitor is None else []
+                    if chunks is not None:
+                        state = chunks.advance(state, step * h, per, states)
                         step += per
-                    else:  # step by step, each recorded
+                    else:
                         for _ in range(per):
-                            state = (chunks.advance(state, step * h, 1) if chunks is not None
-                                     else integ.advance(state, step * h, h))
+                            state = integ.advance(state, step * h, h)
                             step += 1
-                            record(step * h)
+                            if states is not None:
+                                states.append(integ.step_state(state, step * h))
+                    record(states)
                 except StepFailure as fail:
                     t1 = (math.floor(fail.t0 / h + 1e-9) + 1) * h
                     tried = (f"nor with the step halved {max_halvings} times (the last try, {fail.h:.3g} s "
@@ -283,19 +290,21 @@ def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: f
         (order 2 under the stabilized variant, an O(h) start-up transient under index3):
         for long runs with many outputs, whose post-processing the KKT solves dominate.
     monitor : callable, optional
-        ``monitor(StepState) -> dict`` called at the start and after every step; the values are
-        stacked over the steps in ``result.monitored`` (with ``t_s``). What a passage records at
-        every step (a contact force, a few heights) without a full output per step, whose
-        post-processing (energies, every contact over the whole wire) costs more than the step.
-        Not with ``handlers``.
+        ``monitor(StepStates) -> dict`` of the states at the start and after every step, called
+        with the states of several steps at once (:class:`~.alpha_run.StepStates`: the steps of
+        an output interval, which the compiled steps record in their calls): each value has
+        one entry per step (first axis); they are joined over the run in ``result.monitored``
+        (with ``t_s``). What a passage records at every step (a contact force, a few heights)
+        without a full output per step, whose post-processing (energies, every contact over
+        the whole wire) costs more than the step. Not with ``handlers``.
     handlers : sequence of EventHandler, optional
         Events between the steps (:mod:`.events`; one handler for now), required for a model
         with wheel/rail contacts (:func:`symcat.simulation.integrate_model` attaches them): the
         run then goes through the event-stepping driver, generalized-alpha steps inside its
         calls (:mod:`.alpha_events`), with outputs every ``t_end / n_out``.
     compiled : bool, optional
-        Without ``handlers``, run the steps as compiled C, many per call (one per call with a
-        ``monitor``; :mod:`.alpha_chunk`: the same steps to the Newton tolerance); with
+        Without ``handlers``, run the steps as compiled C, many per call
+        (:mod:`.alpha_chunk`: the same steps to the Newton tolerance); with
         ``handlers``, compile the rest of each step. The
         code is compiled once per model and cached. None (default): compiled if cached or if
         the run has at least :data:`CHUNK_COMPILE_STEPS` steps (the rest of wheel/rail steps:

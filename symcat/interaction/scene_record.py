@@ -101,10 +101,11 @@ class SceneRecord:
 
 
 def _monitor(form, model, elements, energy, snapshot_every: float):
-    """Per-step records of the penalty contacts' passage (generalized-alpha's ``monitor``):
-    what the statistics need at every step, without a full output per step (one column per
-    pantograph; the force on each tension section's contact wire in ``contact_force_wire_N``,
-    a pan-head's force their sum and its penetration the largest), the work rates of the
+    """Per-step records of the penalty contacts' passage (generalized-alpha's ``monitor``, of
+    the states after several steps at once): what the statistics need at every step, without
+    a full output per step (one column per pantograph; the force on each tension section's
+    contact wire in ``contact_force_wire_N``, a pan-head's force their sum and its
+    penetration the largest), the work rates of the
     energy balance (``energy``: the model's :class:`~symcat.assembly.energy.EnergyTerms`) and
     the energy at the snapshots (``energy_J``, NaN between them)."""
     st = form.structure
@@ -122,17 +123,18 @@ def _monitor(form, model, elements, energy, snapshot_every: float):
     supports = st.cw_xyz[st.support_nodes, 2]
     next_snapshot = [0.0]
 
-    def monitor(s):
-        force = np.where(has, s.force_N[at], 0.0)
-        driving, other = energy.power(s.q, s.v, s.sc_m, s.multipliers, s.t_s)
-        e = np.nan
-        if s.t_s >= next_snapshot[0] - 1e-9:  # as the snapshots (_snapshots)
-            e = sum(energy.energy(s.q, s.v, s.sc_m))
-            next_snapshot[0] = s.t_s + snapshot_every
-        return {"x_contact_m": s.q[heads], "contact_force_N": force.sum(axis=1), "contact_force_wire_N": force,
-                "penetration_m": np.where(has, -s.gap_m[at], -np.inf).max(axis=1), "panhead_z_m": s.q[heads + 2],
-                "panhead_acc_m_s2": s.a[heads + 2], "support_z_m": s.q[supports],
-                "dropper_tension_N": st.dropper_state(s.q[: st.n])[2], "work_power_W": driving,
+    def monitor(s):  # the states after several steps (StepStates): one row per step
+        force = np.where(has, s.force_N[:, at], 0.0)
+        driving, other = energy.powers(s.q, s.v, s.sc_m, s.multipliers, s.t_s)
+        e = np.full(len(s), np.nan)
+        for i, t in enumerate(s.t_s):
+            if t >= next_snapshot[0] - 1e-9:  # as the snapshots (_snapshots)
+                e[i] = sum(energy.energy(s.q[i], s.v[i], s.sc_m[i]))
+                next_snapshot[0] = t + snapshot_every
+        return {"x_contact_m": s.q[:, heads], "contact_force_N": force.sum(axis=2), "contact_force_wire_N": force,
+                "penetration_m": np.where(has, -s.gap_m[:, at], -np.inf).max(axis=2), "panhead_z_m": s.q[:, heads + 2],
+                "panhead_acc_m_s2": s.a[:, heads + 2], "support_z_m": s.q[:, supports],
+                "dropper_tension_N": st.dropper_state(s.q[:, : st.n])[2], "work_power_W": driving,
                 "dissipation_power_W": -other, "energy_J": e}
 
     return monitor

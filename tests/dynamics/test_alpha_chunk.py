@@ -156,10 +156,10 @@ def test_the_factor_renewed_in_a_call_is_the_next_calls(monkeypatch):
     seen = []
     call = CompiledSteps._call
 
-    def watched(self, s, t, n):
+    def watched(self, s, t, n, states=None):
         renew, before = self._renew, self._factor.copy()
         count = self.integ.compiled_factorizations
-        done = call(self, s, t, n)
+        done = call(self, s, t, n, states)
         inside = self.integ.compiled_factorizations - count - renew
         if not renew:
             seen.append((inside, not np.array_equal(before, self._factor)))
@@ -282,22 +282,44 @@ def test_compiled_steps_of_a_penalty_contact_that_opens_and_closes(record_proper
 
 
 def test_a_per_step_monitor_on_compiled_steps(record_property):
-    """A per-step monitor (what a passage records at every step) with the steps compiled, one to
-    a call: the same records, step for step, as the Python steps', within the Newton
-    tolerance; the contact opens and closes in between."""
+    """A per-step monitor (what a passage records at every step) with the steps compiled, the
+    steps of an output interval in one call that records each step's state: the same records,
+    step for step, as the Python steps' (positions, velocities, accelerations, contact gap and
+    force), within the Newton tolerance; the contact opens and closes in between."""
+    from unittest import mock
+
+    from symcat.integrate.alpha_chunk import CompiledSteps
     from tests.dynamics.test_contact import head_under_wire
 
-    def gaps(s):
-        return {"gap_m": s.gap_m.copy(), "head_z_m": s.q[-1]}
+    def monitor(s):
+        return {"gap_m": s.gap_m.copy(), "force_N": s.force_N.copy(), "head_z_m": s.q[:, -1],
+                "head_vz_m_s": s.v[:, -1], "head_az_m_s2": s.a[:, -1]}
 
-    runs = [generalized_alpha(head_under_wire(v0=-2.0)[0], 0.15, 5e-4, rho_inf=0.9, n_out=20, progress=False,
-                              multipliers="integrator", tol=1e-10, variant="index3", monitor=gaps,
-                              compiled=compiled) for compiled in (False, True)]
+    calls = []
+    original = CompiledSteps._call
+
+    def counted(self, *args):
+        calls.append(args[2])
+        return original(self, *args)
+
+    runs = []
+    for compiled in (False, True):
+        with mock.patch.object(CompiledSteps, "_call", counted):
+            runs.append(generalized_alpha(head_under_wire(v0=-2.0)[0], 0.15, 5e-4, rho_inf=0.9, n_out=20,
+                                          progress=False, multipliers="integrator", tol=1e-10, variant="index3",
+                                          monitor=monitor, compiled=compiled))
     python, compiled = (np.asarray(r.monitored["gap_m"]).ravel() for r in runs)
     assert runs[1].stats["compiled_steps"] == runs[1].stats["steps"] == 300
+    assert len(calls) == 20  # one call per output interval of 15 steps, each step recorded
     assert len(runs[1].monitored["t_s"]) == 301
-    assert np.array_equal(runs[1].monitored["t_s"], runs[0].monitored["t_s"])
+    assert np.allclose(runs[1].monitored["t_s"], runs[0].monitored["t_s"], rtol=0, atol=1e-12)
     apart = np.abs(compiled - python).max()
     record_property("apart_m", apart)
     assert apart < 1e-6
+    for key, scale in (("head_z_m", 1e-6), ("head_vz_m_s", 1e-3), ("head_az_m_s2", 1.0), ("force_N", 0.1)):
+        a, b = (np.asarray(r.monitored[key]).ravel() for r in runs)
+        record_property(f"{key}_apart", float(np.abs(a - b).max()))
+        assert a.shape == b.shape == (301,)
+        assert np.abs(a - b).max() < scale, key
+    assert np.abs(runs[1].monitored["force_N"]).max() > 10.0  # (the forces compared are not all zero)
     assert (compiled > 0).any() and (compiled <= 0).any()

@@ -76,9 +76,9 @@ def test_potential_slope_is_minus_the_conservative_forces(line):
 def _balance_error(model, energy, dt):
     power, total = [], []
 
-    def monitor(s):
-        power.append(sum(energy.power(s.q, s.v, s.sc_m, s.multipliers, s.t_s)))
-        total.append(sum(energy.energy(s.q, s.v, s.sc_m)))
+    def monitor(s):  # the states after several steps
+        power.extend(sum(energy.powers(s.q, s.v, s.sc_m, s.multipliers, s.t_s)))
+        total.extend(sum(energy.energy(s.q[i], s.v[i], s.sc_m[i])) for i in range(len(s)))
         return {}
 
     generalized_alpha(model, 0.2, dt, 1.0, variant="index3", n_out=4, tol=1e-9, progress=False,
@@ -97,3 +97,24 @@ def test_passage_energy_balance_converges_at_second_order(line):
     assert work > 2.0
     assert coarse < 2e-3 * work
     assert coarse / fine > 2.8
+
+
+def test_powers_of_several_states_are_each_states_power(line):
+    """A monitor's batch of states (one row per step, the contact's point on different elements
+    and penetrations, one state off the wire) has the powers each state has alone."""
+    model, energy = line
+    rng = np.random.default_rng(2)
+    k = 5
+    q = np.tile(model.q0, (k, 1))
+    v = np.zeros((k, model.n_q))
+    q[:, model.free] += 1e-3 * rng.standard_normal((k, model.free.size))
+    v[:, model.free] = 1e-2 * rng.standard_normal((k, model.free.size))
+    starts = model.contacts[0].element_start
+    sc = np.array([[model.sc0[0]], [model.sc0[0] + 1.3], [starts[3] + 0.1], [starts[-1] + 1.0], [model.sc0[0]]])
+    lam = rng.standard_normal((k, len(model.row_names)))
+    t = np.linspace(0.0, 0.1, k)
+    driving, other = energy.powers(q, v, sc, lam, t)
+    alone = np.array([energy.power(q[i], v[i], sc[i], lam[i], t[i]) for i in range(k)])
+    np.testing.assert_allclose(driving, alone[:, 0], rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(other, alone[:, 1], rtol=1e-12, atol=1e-9)
+    assert np.ptp(other) > 1.0  # (states whose powers differ)
