@@ -97,18 +97,18 @@ def hard_cases() -> list[str]:
 
 def _scene_run(n_spans: int) -> tuple[int, float]:
     """Coordinates and wall per simulated second of benchmark2015 on the multibody path
-    (``pantograph=lumped_scene``), ``n_spans`` spans, 0.5 s simulated."""
+    (``pantograph=lumped``), ``n_spans`` spans, 0.5 s simulated."""
     from symcat.model import run_model
 
-    out = run_model("benchmark2015", {"pantograph": "lumped_scene", "n_spans": n_spans, "t_end": 0.5,
+    out = run_model("benchmark2015", {"pantograph": "lumped", "n_spans": n_spans, "t_end": 0.5,
                                       "progress": False, "paraview": False})
     return out.summary["n_coordinates"], out.summary["wall_per_simulated_s"]
 
 
 def unified_paths(repeats: int = 3) -> list[str]:
-    """The model benchmark2015 on the interaction path (``pantograph=lumped``) and on the shared
-    multibody path (``lumped_scene``: the same pantograph as scene bodies, generalized-alpha on
-    the catenary scene), interleaved runs, medians of ``repeats``: statistics apart and the
+    """The model benchmark2015 on the interaction path (``pantograph=lumped_interaction``) and on
+    the shared multibody path (``lumped``, the default: the same pantograph as scene bodies,
+    generalized-alpha on the catenary scene), interleaved runs, medians of ``repeats``: statistics apart and the
     ratio of wall per simulated second (static placement and time integration on both paths),
     the multibody path's with its compiled steps (built in the background after a first run)
     and, in the last column, with its Python steps (a first run on a machine)."""
@@ -124,13 +124,13 @@ def unified_paths(repeats: int = 3) -> list[str]:
     from symcat.codegen.optimized import wait_for_background
 
     for label, params in cases:
-        walls = {"lumped": [], "lumped_scene": []}
+        walls = {"lumped_interaction": [], "lumped": []}
         stats = {}
         # A line's compiled steps are built in the background after its first run, which steps
         # in Python: the timed runs use them, the last column is the Python steps'.
         # (the users' default mode, background: the bench's own, "now", compiles a line's steps
         # only for runs of CHUNK_COMPILE_STEPS steps or more)
-        multibody = {**params, "pantograph": "lumped_scene", "progress": False, "paraview": False}
+        multibody = {**params, "pantograph": "lumped", "progress": False, "paraview": False}
         with mock.patch.dict(os.environ, {"SYMCAT_OPTIMIZE": "background"}):
             run_model("benchmark2015", multibody)
             wait_for_background()
@@ -145,8 +145,8 @@ def unified_paths(repeats: int = 3) -> list[str]:
                 summary = out.summary.get("pantograph_1", out.summary)
                 stats[path] = {k: summary[k] for k in ("contact_force_mean_N", "contact_force_std_N",
                                                        "contact_force_max_N")}
-        a, b = stats["lumped"], stats["lumped_scene"]
-        wa, wb = statistics.median(walls["lumped"]), statistics.median(walls["lumped_scene"])
+        a, b = stats["lumped_interaction"], stats["lumped"]
+        wa, wb = statistics.median(walls["lumped_interaction"]), statistics.median(walls["lumped"])
         lines.append(f"| {label} | {abs(b['contact_force_mean_N'] - a['contact_force_mean_N']):.3f} | "
                      f"{abs(b['contact_force_std_N'] - a['contact_force_std_N']):.3f} | "
                      f"{abs(b['contact_force_max_N'] - a['contact_force_max_N']):.2f} | {wa:.2f} | {wb:.2f} | "
@@ -213,7 +213,7 @@ def section(report_dir: Path) -> list[str]:
         "",
         "### Cost against line length (60 elements/span, dt 1 ms, 0.5 s simulated, median of 3)",
         "",
-        "Interaction path (`pantograph=lumped`) and the shared multibody path (`pantograph=lumped_scene`, one run "
+        "Interaction path (`pantograph=lumped_interaction`) and the shared multibody path (`pantograph=lumped`, one run "
         "each; its coordinates include the pantograph's bodies). The target of issue 28: 80 spans at most 9 times "
         "10 spans on the multibody path.",
         "",
@@ -230,7 +230,8 @@ def section(report_dir: Path) -> list[str]:
         "### The shared multibody path against the interaction path (model benchmark2015, 320 km/h unless stated)",
         "",
         "The lumped pantograph as scene bodies under the catenary scene, integrated by the shared generalized-alpha "
-        "(`pantograph=lumped_scene`), against the interaction path (`pantograph=lumped`): statistics apart (the "
+        "(`pantograph=lumped`, the models' default), against the interaction path (`pantograph=lumped_interaction`): "
+        "statistics apart (the "
         "last run of each) and wall time per simulated second, static placement and time integration on both paths "
         "(the multibody path's static solve, a step of its own, is counted since 2026-11-27; medians of 3 "
         "interleaved runs; ratio multibody / interaction).",

@@ -42,13 +42,16 @@ clamp masses +4 to +15 mm, a messenger of 1.07 kg/m +0.7 to +2.3 mm, a 1 kg stea
 -1.4 mm, an unpreloaded messenger support (5e5 N/m) -2.6 mm, the encumbrance measured to the
 contact wire's static height at the support -6 mm.
 
-``pantograph=seo2005`` runs the seed paper's four-body pantograph instead (scene bodies on the
-multibody path, :mod:`symcat.interaction.scene_passage`; penalty contact, as the wire is
-staggered, handed over between the sections' wires in overlaps; one or two;
-``pantograph=lumped_scene`` runs the lumped one there, one or two, in penalty contact or in
-bilateral contact through a shoe that follows the stagger): its plunger uplift is trimmed so that the static
-contact force is the lumped pantograph's (``uplift_N`` or the EN 50367 target, plus the
-aerodynamic ``c v^2`` on the pan-head), and the summary reports that uplift (``uplift_N``).
+The pantographs are scene bodies on the multibody path (:mod:`symcat.interaction.scene_passage`:
+the catenary scene, the joint static equilibrium, generalized-alpha): ``pantograph=lumped`` (the
+default) the benchmark's three-mass pantograph (carrier, stages on prismatic joints,
+spring-dampers, uplift), ``pantograph=seo2005`` the seed paper's four-body pantograph; one or two,
+in penalty contact (handed over between the sections' wires in overlaps) or, the lumped one, in
+bilateral contact through a shoe that follows the stagger. The plunger uplift is trimmed so
+that the static contact force is the lumped pantograph's (``uplift_N`` or the EN 50367 target,
+plus the aerodynamic ``c v^2`` on the pan-head); the summary reports that uplift (``uplift_N``).
+``pantograph=lumped_interaction`` runs the lumped pantograph on the earlier interaction path
+(:mod:`symcat.interaction.passage`: its own contact model and integrator), kept for comparison.
 
 As built: ``dropper_length_sd_m``, ``support_height_sd_m``, ``contact_wire_irregularity_m`` (with
 ``irregularity_correlation_m``) and ``deviation_seed`` build the form-found line with sampled
@@ -144,9 +147,9 @@ def run(p: dict):
     uplift = base.uplift if p["uplift_N"] < 0 else p["uplift_N"]
     panto = LumpedPantograph(base.masses, base.stiffness, damping, uplift, base.uplift_stage,
                              aero_coefficient=p["aero_coefficient_N_s2_m2"], name=base.name, sources=base.sources)
-    if p["pantograph"] != "lumped":  # a multibody pantograph with the lumped one's static contact force
+    if p["pantograph"] != "lumped_interaction":  # scene bodies with the lumped pantograph's static contact force
         check_scene_pantograph(p, design.stagger, design.n_sections,
-                               {} if p["pantograph"] == "lumped_scene" else
+                               {} if p["pantograph"] == "lumped" else
                                {"pantograph_damping_N_s_m": (p["pantograph_damping_N_s_m"], "0,0,0")})
         extra = {"speed_kmh": p["speed_kmh"], "n_spans": design.line_spans, "tension_sections": design.n_sections,
                  "wave_speed_kmh": design.wave_speed * 3.6, **as_built}

@@ -24,11 +24,13 @@ the value it used under its table. The presag is the open value the result depen
 | 40 mm | uplift 46.7 mm (< 48) | mean 120.0 N, stat. max, uplift 53.3 mm out |
 | 55 mm (default) | uplift 44.2 mm (< 48) | sigma 44.1 N and 5 more out |
 
-``pantograph=seo2005`` runs the seed paper's four-body pantograph instead (scene bodies on the
-multibody path, :mod:`symcat.interaction.scene_passage`; penalty or, the wire being unstaggered,
-bilateral contact): its plunger uplift is trimmed so that the static contact force is
-``static_force_N``, and the summary reports that uplift (``uplift_N``). It is not the standard's
-reference pantograph: the standard's ranges are meant for the lumped one.
+The pantograph runs as scene bodies on the multibody path (:mod:`symcat.interaction.scene_passage`;
+penalty or, the wire being unstaggered, bilateral contact), its plunger uplift trimmed so that
+the static contact force is ``static_force_N`` (the summary reports that uplift, ``uplift_N``):
+``pantograph=lumped`` (default) the reference two-mass pantograph, ``pantograph=seo2005`` the
+seed paper's four-body pantograph (not the standard's reference pantograph: the standard's
+ranges are meant for the lumped one). ``pantograph=lumped_interaction`` runs the lumped one on
+the earlier interaction path (:mod:`symcat.interaction.passage`), kept for comparison.
 
 As built: ``dropper_length_sd_m``, ``support_height_sd_m``, ``contact_wire_irregularity_m`` (with
 ``irregularity_correlation_m``) and ``deviation_seed`` build the form-found line with sampled
@@ -75,7 +77,7 @@ def run(p: dict):
                              f"{design.wave_speed * 3.6:.1f} km/h")
     p = scene_pantograph_choice(p)
     form, as_built = as_built_form(design, p, p["elements_per_span"], p["element"], p["progress"])  # deviations
-    if p["pantograph"] != "lumped":  # a multibody pantograph pressing with static_force_N
+    if p["pantograph"] != "lumped_interaction":  # scene bodies pressing with static_force_N
         check_scene_pantograph(p, design.stagger)
         extra = {"speed_kmh": p["speed_kmh"], "static_force_N": p["static_force_N"],
                  "wave_speed_kmh": design.wave_speed * 3.6, "choices": design.sources, **as_built}

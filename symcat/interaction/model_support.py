@@ -107,28 +107,29 @@ def passage_output(result: PassageResult, p: dict, stem: str, extra: dict | None
 
 
 #: The pantograph model of a line-scale passage (benchmark2015, en50318).
-PANTOGRAPH_CHOICES = ("lumped", "lumped_scene", "seo2005")
+PANTOGRAPH_CHOICES = ("lumped", "seo2005", "lumped_interaction")
 PANTOGRAPH_PARAMETER = Parameter(
-    "pantograph", "lumped", "", "pantograph model: lumped (the model's lumped-mass pantograph on the interaction "
-    "path), lumped_scene (the same pantograph as scene bodies on the shared multibody path) or seo2005 (the seed "
-    "paper's four-body pantograph as scene bodies); on the multibody path the uplift is trimmed to the static contact "
-    "force, overlaps need contact=penalty; lumped with contact=bilateral runs as lumped_scene (the interaction "
-    "path's bilateral contact is unstable on the default mesh)",
+    "pantograph", "lumped", "", "pantograph model: lumped (the model's lumped-mass pantograph as scene bodies on the "
+    "multibody path) or seo2005 (the seed paper's four-body pantograph as scene bodies); their uplift is trimmed to "
+    "the static contact force, overlaps need contact=penalty; lumped_interaction: the lumped pantograph on the "
+    "earlier interaction path (its own contact model and integrator, kept for comparison; with contact=bilateral it "
+    "runs as lumped: its sliding contact is unstable on the default mesh)",
     choices=PANTOGRAPH_CHOICES)
 
 
 def scene_pantograph_choice(p: dict) -> dict:
     """The model parameters ``p`` with the path that runs them: the lumped pantograph in
-    bilateral contact runs as ``lumped_scene`` (the interaction path's sliding contact goes
-    unstable on fine meshes: 60 elements per span at 1 ms reached 1e5 N within 0.05 s)."""
-    if p.get("pantograph", "lumped") == "lumped" and p.get("contact") == "bilateral":
-        return {**p, "pantograph": "lumped_scene"}
+    bilateral contact runs on the multibody path (``lumped``: the interaction path's sliding
+    contact goes unstable on fine meshes, 60 elements per span at 1 ms reached 1e5 N within
+    0.05 s)."""
+    if p.get("pantograph", "lumped") == "lumped_interaction" and p.get("contact") == "bilateral":
+        return {**p, "pantograph": "lumped"}
     return p
 
 
 def check_scene_pantograph(p: dict, stagger: float, tension_sections: int = 1,
                            lumped_only: dict | None = None) -> None:
-    """Refuse, before any work, what ``pantograph=seo2005`` cannot run (one line each, naming
+    """Refuse, before any work, what a multibody pantograph cannot run (one line each, naming
     the parameters, their values and what is allowed).
 
     Parameters
@@ -142,7 +143,7 @@ def check_scene_pantograph(p: dict, stagger: float, tension_sections: int = 1,
     lumped_only : dict, optional
         Parameter name -> (value, default) of parameters that only the lumped pantograph has.
     """
-    if p.get("pantograph", "lumped") == "lumped":
+    if p.get("pantograph", "lumped") == "lumped_interaction":
         return
     name = f"pantograph={p['pantograph']}"
     if tension_sections != 1 and p["contact"] == "bilateral":
@@ -150,7 +151,7 @@ def check_scene_pantograph(p: dict, stagger: float, tension_sections: int = 1,
                              "cannot pass an overlap; allowed: contact=penalty, or tension_sections=1")
     # the lumped pantograph's bilateral contact is a shoe sliding across its pan-head, which
     # follows the stagger; the four-body pantograph's sliding joint is on its pan-head's centre
-    if p["contact"] == "bilateral" and stagger != 0 and p["pantograph"] != "lumped_scene":
+    if p["contact"] == "bilateral" and stagger != 0 and p["pantograph"] != "lumped":
         raise ParameterError(f"contact=bilateral with {name}: the contact wire is staggered (+/-{abs(stagger):g} m) "
                              "and the sliding joint would pull it onto the pantograph's plane; allowed: "
                              "contact=penalty")
@@ -166,7 +167,7 @@ def run_scene_pantograph(design, p: dict, speed: float, target_force: float, ste
     the static contact force ``target_force`` (N) by
     :func:`~.scene_passage.run_scene_passage`, with the model's numerical and contact
     parameters; summary and files as :func:`passage_output`, plus the trimmed uplift.
-    ``lumped``: the model's :class:`~symcat.pantograph.LumpedPantograph` (for ``lumped_scene``;
+    ``lumped``: the model's :class:`~symcat.pantograph.LumpedPantograph` (for ``pantograph=lumped``;
     its own aerodynamic force, so ``aero_force`` is for ``seo2005`` only). ``form``: the
     form-found ``design`` to run on (an as-built one, :mod:`symcat.catenary.deviations`), else
     form-found here."""
@@ -178,7 +179,7 @@ def run_scene_pantograph(design, p: dict, speed: float, target_force: float, ste
     o = numerical_options(p)
     if form is None:
         form = find_form(design, o["elements_per_span"], o["element"], progress=o["progress"])
-    if p["pantograph"] == "lumped_scene":
+    if p["pantograph"] == "lumped":
         n = p.get("n_pantographs", 1)
         fragment = [lumped_fragment(lumped, p["contact"], p["contact_stiffness"], p["contact_damping"], form=form,
                                     name="pantograph" if n == 1 else f"pantograph_{k + 1}") for k in range(n)]

@@ -112,7 +112,8 @@ def lumped_fragment(pantograph, contact: str = "penalty", contact_stiffness: flo
         return info["contact"]
 
     return ScenePantograph(add, uplift=float(pantograph.uplift), name=f"{pantograph.name} (scene)",
-                           description=f"{pantograph.name} as scene bodies", placed=form is not None)
+                           description=f"{pantograph.name} pantograph ({len(pantograph.masses)} masses)",
+                           placed=form is not None)
 
 
 def contact_element(scene, name: str):

@@ -83,8 +83,8 @@ def test_the_multibody_path_runs_on_the_same_as_built_catenary():
     and the same static contact force on it."""
     errs = {"dropper_length_sd_m": 0.005, "support_height_sd_m": 0.003, "deviation_seed": 5, "t_end": 0.0,
             "elements_per_span": 10, "n_spans": 5, "progress": False, "paraview": False}
-    a = run_model("en50318", {**errs, "pantograph": "lumped"}).summary
-    b = run_model("en50318", {**errs, "pantograph": "lumped_scene"}).summary
+    a = run_model("en50318", {**errs, "pantograph": "lumped_interaction"}).summary
+    b = run_model("en50318", {**errs, "pantograph": "lumped"}).summary
     for key in ("as_built_height_rms_m", "as_built_height_max_m", "as_built_dropper_error_rms_m", "dropper_lengths_m"):
         assert a[key] == b[key], key
     assert b["static_contact_force_N"] == pytest.approx(120.0, rel=1e-5)
