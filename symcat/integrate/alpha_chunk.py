@@ -159,6 +159,9 @@ class CompiledSteps:
                 self.disabled = f"a line whose wires cannot be compiled as loops ({unloopable(st.form)})"
                 return False
             self._fns, key = _compiled(st, self.integ.coef, self.build)
+            # recorded even before its library exists (a background job may be building it):
+            # the next runs find it without the step equations or the library key
+            write_record(self._key, key, st.mass_scale)
             if self._fns is None:
                 self.disabled = ("not compiled yet, and a short run or a line (see generalized_alpha's compiled and "
                                  "_compiled)")
@@ -167,7 +170,6 @@ class CompiledSteps:
             log.warning("generalized-alpha steps could not be compiled (%s); stepping in Python", exc)
             self.disabled = str(exc)
             return False
-        write_record(self._key, key, st.mass_scale)
         self._prepare(st.mass_scale)
         return True
 

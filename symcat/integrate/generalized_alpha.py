@@ -183,8 +183,6 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
 
     def record(states: list):
         """The monitor's values of the states after some steps (one call, all of them)."""
-        if monitor is None:
-            return
         batch = StepStates.stacked(states)
         values = monitor(batch)
         run.monitored.setdefault("t_s", []).append(batch.t_s)
@@ -194,7 +192,8 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
                                  "monitor gets the states of several steps, its values one entry per step)")
             run.monitored.setdefault(key, []).append(value)
 
-    record([integ.step_state(state, 0.0)])
+    if monitor is not None:
+        record([integ.step_state(state, 0.0)])
     bar = Progress("generalized-alpha", t_end, "s", enabled=progress)
     step = 0
     try:
@@ -211,7 +210,8 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
                             step += 1
                             if states is not None:
                                 states.append(integ.step_state(state, step * h))
-                    record(states)
+                    if states is not None:
+                        record(states)
                 except StepFailure as fail:
                     t1 = (math.floor(fail.t0 / h + 1e-9) + 1) * h
                     tried = (f"nor with the step halved {max_halvings} times (the last try, {fail.h:.3g} s "
