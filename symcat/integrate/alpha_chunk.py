@@ -113,12 +113,15 @@ class CompiledSteps:
         self._key = model_key(integ.model, integ.form, _settings(integ.variant, integ.coef))
         self._record = read_record(self._key)
         self.disabled = unsupported(integ, self._record is not None)
+        self._awaited = None  # a line's library that a background job is building (see _pick_up)
 
     def advance(self, s: State, t0: float, n: int, states: list | None = None) -> State:
         """The state ``n`` steps of :attr:`h` after ``s`` at ``t0``; with ``states`` (a list),
         the :class:`~.alpha_run.StepStates` after each step appended to it (a monitored run)."""
         integ, h = self.integ, self.h
         k = 0
+        if self._awaited is not None:
+            self._pick_up()
         while k < n:
             renew = self._renew
             if self.disabled is None and self._ready(s, t0 + k * h):
@@ -165,6 +168,7 @@ class CompiledSteps:
             if self._fns is None:
                 self.disabled = ("not compiled yet, and a short run or a line (see generalized_alpha's compiled and "
                                  "_compiled)")
+                self._awaited = awaited_library(st, key)
                 return False
         except (RuntimeError, CompilerError) as exc:  # no compiler, or a kernel without SX form
             log.warning("generalized-alpha steps could not be compiled (%s); stepping in Python", exc)
@@ -172,6 +176,17 @@ class CompiledSteps:
             return False
         self._prepare(st.mass_scale)
         return True
+
+    def _pick_up(self) -> None:
+        """Load the library :attr:`_awaited` if its background job has built it: the rest of a
+        line's first run steps compiled (the job takes seconds to a minute; a first run of a
+        long passage would else step in Python to its end)."""
+        if not self._awaited.exists():
+            return
+        self._fns, self._awaited = loaded(self._awaited), None
+        self._prepare(self.integ.stepper.mass_scale)
+        self.disabled, self._renew = None, True
+        log.info("generalized-alpha: the compiled steps built in the background are loaded; the run continues on them")
 
     def _load_recorded(self) -> bool:
         """Load the library of the model's record (without the Python step equations); False
@@ -292,17 +307,18 @@ def _compiled(st: StepEquations, coef, build: bool | str) -> tuple[dict | None, 
     library's key (which names it, for the model's record). A line (wires built as loops,
     :func:`.alpha_chunk_wires.looped`) under ``$SYMCAT_OPTIMIZE=background`` uses its
     optimized library only: without one, it is left to a background job for the next runs
-    (:mod:`.alpha_chunk_later`) and this run's steps stay in Python (None). Under ``off`` a
+    (:mod:`.alpha_chunk_later`) and this run's steps stay in Python (None) until it is built
+    (:meth:`CompiledSteps._pick_up`). Under ``off`` a
     line is built (at -O0, slower than its Python steps) only when asked (``build=True``, not
     ``"long"``: a long run's own choice)."""
-    from ..codegen.model_dae import cached_library, compiled_library
+    from ..codegen.model_dae import compiled_library
     from ..codegen.optimized import optimize_mode
 
     key = library_key(st, coef)
     if looped(st.form.model) and optimize_mode() == "off" and build is not True:
         return None, key
-    if looped(st.form.model) and optimize_mode() == "background":
-        library = cached_library("alpha_chunk", key.encode(), OPTIMIZED_FLAGS)
+    library = awaited_library(st, key)
+    if library is not None:
         if library.exists():
             return loaded(library), key
         with symbolic_kernels():
@@ -319,6 +335,18 @@ def _compiled(st: StepEquations, coef, build: bool | str) -> tuple[dict | None, 
     if path is None:
         return None, key
     return loaded(path), key
+
+
+def awaited_library(st: StepEquations, key: str) -> Path | None:
+    """The optimized library a background job builds for a line (:func:`_compiled` under
+    ``$SYMCAT_OPTIMIZE=background``) whose library key digests to ``key``; None for any other
+    model or mode (nothing is built while the run goes on)."""
+    from ..codegen.model_dae import cached_library
+    from ..codegen.optimized import optimize_mode
+
+    if not (looped(st.form.model) and optimize_mode() == "background"):
+        return None
+    return cached_library("alpha_chunk", key.encode(), OPTIMIZED_FLAGS)
 
 
 def _graph(residual: ChunkResidual) -> ca.Function:
