@@ -60,3 +60,26 @@ def test_numeric_forces_and_jacobians_equal_the_graphs(element, damped, moment, 
     f_static = system.internal_force(qs) + 0.3 * system.external_force(qs)
     ref = to_scipy(ca.DM(ca.Function("s", [qs], [-ca.jacobian(f_static, qs)])(q)))
     assert none is None and abs(k_static - ref).max() <= 1e-12 * k_scale
+
+
+def test_pattern_sum_keeps_the_union_of_the_patterns_when_values_cancel():
+    """PatternSum: the sum of sparse terms on the fixed union of their patterns (an entry whose
+    values cancel stays, explicit), equal to SciPy's sum; one, several and empty terms."""
+    import scipy.sparse as sps
+
+    from symcat.assembly.sparse import PatternSum
+
+    shape = (40, 30)
+    terms = [sps.random(*shape, density=d, random_state=k, format="csc") for k, d in enumerate((0.1, 0.2, 0.0, 0.05))]
+    for t in terms:
+        t.sort_indices()
+    terms.append(-terms[0])  # cancels the first term's values: its entries stay in the pattern
+    for chosen in ([0], [0, 1], [0, 1, 2, 3, 4], [2]):
+        picked = [terms[i] for i in chosen]
+        s = PatternSum([(t.indptr, t.indices) for t in picked], shape)
+        union = sum(sps.csc_matrix((np.ones(t.nnz), t.indices, t.indptr), shape=shape) for t in picked)
+        got = s.csc([t.data for t in picked])
+        assert got.nnz == s.nnz == sps.csc_matrix(union).nnz  # the union, explicit zeros included
+        pattern = sps.csc_matrix((np.ones(s.nnz), s.indices, s.indptr), shape=shape).toarray()
+        assert np.array_equal(pattern > 0, np.asarray(union.todense()) > 0)
+        np.testing.assert_allclose(got.toarray(), sum(t.toarray() for t in picked), atol=1e-15)
