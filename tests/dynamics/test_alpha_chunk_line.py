@@ -111,7 +111,7 @@ def _code(elements: int) -> str:
     constant matrices) left out and its numbers replaced by a placeholder."""
     integ = _stepper(line(elements)[0])
     with symbolic_kernels():
-        functions = alpha_chunk._chunk_functions(integ.stepper, integ.coef)
+        functions = alpha_chunk.chunk_functions(integ.stepper, integ.coef)
     gen = ca.CodeGenerator("alpha_chunk.c", {"with_header": False})
     for fn in functions:
         gen.add(fn)
@@ -188,7 +188,7 @@ def test_a_long_run_of_a_line_steps_in_python_without_optimization(loops, monkey
     monkeypatch.setenv("SYMCAT_OPTIMIZE", "off")
     monkeypatch.setattr(ga, "CHUNK_COMPILE_STEPS", 10)
     built = []
-    monkeypatch.setattr(alpha_chunk, "_chunk_functions", lambda *a: built.append(a) or [])
+    monkeypatch.setattr(alpha_chunk, "chunk_functions", lambda *a: built.append(a) or [])
     # a library of this model cached by an earlier test or run would be used: none here
     monkeypatch.setattr(alpha_chunk, "read_record", lambda key: None)
     monkeypatch.setattr(alpha_chunk, "library_key", lambda st, coef: f"never-cached-{os.getpid()}-{id(st)}")
