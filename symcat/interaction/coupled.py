@@ -19,7 +19,7 @@ import scipy.sparse.linalg as spla
 from ..catenary.formfinding import FormFindingResult, coupled_equilibrium
 from ..errors import ParameterError, SolverError
 from ..pantograph.lumped import LumpedPantograph
-from .contact import WireLocator, WirePoint, contact_wire_locators, hermite, point_loads, running_wire
+from ..catenary.contact_wire import WireLocator, WirePoint, contact_wire_locators, hermite, point_loads, running_wire
 
 CONTACT_MODELS = ("penalty", "bilateral")
 

@@ -146,7 +146,7 @@ def static_force(eq, element) -> float:
 def running_contact_wire(form: FormFindingResult, x: float) -> str:
     """Scene name of the contact wire in running at ``x`` (m): the lowest one there in the
     static catenary (the one a pan-head at ``x`` touches)."""
-    from .contact import contact_wire_locators, running_wire
+    from ..catenary.contact_wire import contact_wire_locators, running_wire
 
     st = form.structure
     return st.contacts[running_wire(st, contact_wire_locators(st), np.asarray(form.q, float), x)].name

@@ -100,7 +100,7 @@ def wire_height(scene: Scene, wire: str, x: float) -> tuple[float, float, float]
     if not xs[0] <= x <= xs[-1]:
         raise ParameterError(f"x={x:g} m: off the wire {wire!r} ({xs[0]:g}..{xs[-1]:g} m)")
     # cubic Hermite on the element, as the interaction path's WireLocator
-    from ..interaction.contact import hermite
+    from ..catenary.contact_wire import hermite
     k = int(np.clip(np.searchsorted(xs, x, side="right") - 1, 0, len(xs) - 2))
     ixx, izx = body.coordinate_index("x_x"), body.coordinate_index("z_x")
     length = float(np.linalg.norm(q0[k + 1, [ix, body.coordinate_index("y"), iz]] - q0[k, [ix, body.coordinate_index("y"), iz]]))
@@ -121,7 +121,7 @@ def wire_height(scene: Scene, wire: str, x: float) -> tuple[float, float, float]
 def running_sections(form, xs) -> list[int]:
     """The contact wire in running (the lowest) at each ``x`` (m) of ``xs`` in the static
     catenary ``form`` (indices of ``form.structure.contacts``)."""
-    from ..interaction.contact import contact_wire_locators, running_wire
+    from ..catenary.contact_wire import contact_wire_locators, running_wire
 
     st = form.structure
     _check_covered(st, xs)
@@ -141,7 +141,7 @@ def loaded_catenary(form, xs, forces, sections=None) -> np.ndarray:
     :func:`running_sections`), by ``coupled_equilibrium``. Kept on ``form`` for the same loads
     (a pantograph's placement and the static solve's starting state ask for the same state)."""
     from ..catenary.formfinding import coupled_equilibrium
-    from ..interaction.contact import contact_wire_locators, point_loads
+    from ..catenary.contact_wire import contact_wire_locators, point_loads
 
     st = form.structure
     xs, forces = [float(x) for x in xs], [float(f) for f in forces]
@@ -183,7 +183,7 @@ def loaded_wire_height(form, x: float, force: float, section: int | None = None,
     structure's static equilibrium under the point load, :func:`loaded_catenary`). ``state``:
     the catenary's coordinates to read the height from instead (a static state under several
     pantographs' forces, ``force`` then unused)."""
-    from ..interaction.contact import contact_wire_locators
+    from ..catenary.contact_wire import contact_wire_locators
 
     _check_covered(form.structure, [x])
     section = running_sections(form, [x])[0] if section is None else section
