@@ -230,7 +230,7 @@ def _start_and_wait_for(args, marker: str, cwd=ROOT, timeout_s: float = 240.0):
 def test_ctrl_c_during_a_passage_keeps_the_histories_so_far(tmp_path):
     out, summary = tmp_path / "out", tmp_path / "s.json"
     proc, seen = _start_and_wait_for(["run", "benchmark2015", "--set", "speed_kmh=60", "--set", "elements_per_span=30",
-                                      "--out", str(out), "--summary", str(summary), "--quiet"], "passage [")
+                                      "--out", str(out), "--summary", str(summary), "--quiet"], "generalized-alpha [")
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130
