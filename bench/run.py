@@ -212,9 +212,9 @@ def main():
 
     pantograph = pantograph_section(REPORT)
     print("line passage on the shared multibody path ...", flush=True)
-    from bench.unified_passage import section as line_section, work_precision
+    from bench.passage_work_precision import work_precision
 
-    line = line_section() + work_precision(REPORT)
+    line = ["## A line passage on the shared multibody path", ""] + work_precision(REPORT)
     print("wheelset ...", flush=True)
     from bench.wheelset import section as wheelset_section
 

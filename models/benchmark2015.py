@@ -50,8 +50,6 @@ in penalty contact (handed over between the sections' wires in overlaps) or, the
 bilateral contact through a shoe that follows the stagger. The plunger uplift is trimmed so
 that the static contact force is the lumped pantograph's (``uplift_N`` or the EN 50367 target,
 plus the aerodynamic ``c v^2`` on the pan-head); the summary reports that uplift (``uplift_N``).
-``pantograph=lumped_interaction`` runs the lumped pantograph on the earlier interaction path
-(:mod:`symcat.interaction.passage`: its own contact model and integrator), kept for comparison.
 
 As built: ``dropper_length_sd_m``, ``support_height_sd_m``, ``contact_wire_irregularity_m`` (with
 ``irregularity_correlation_m``) and ``deviation_seed`` build the form-found line with sampled
@@ -69,12 +67,9 @@ from symcat.interaction.model_support import (
     NUMERICAL_PARAMETERS,
     PANTOGRAPH_PARAMETER,
     check_scene_pantograph,
-    numerical_options,
-    passage_output,
     run_scene_pantograph,
-    scene_pantograph_choice,
 )
-from symcat.interaction.passage import run_passage, spans_needed
+from symcat.interaction.passage import spans_needed
 from symcat.model import Model, Parameter, comma_numbers, numbers_check
 from symcat.pantograph import LumpedPantograph, benchmark2015_pantograph
 
@@ -140,27 +135,20 @@ def run(p: dict):
     if not speed < design.wave_speed:
         raise ParameterError(f"speed_kmh={p['speed_kmh']:g} km/h: must be below the contact-wire wave speed "
                              f"{design.wave_speed * 3.6:.1f} km/h")
-    p = scene_pantograph_choice(p)
     form, as_built = as_built_form(design, p, p["elements_per_span"], p["element"], p["progress"])  # deviations
     base = benchmark2015_pantograph(p["speed_kmh"])
     damping = comma_numbers(p["pantograph_damping_N_s_m"], "pantograph_damping_N_s_m", 3)
     uplift = base.uplift if p["uplift_N"] < 0 else p["uplift_N"]
     panto = LumpedPantograph(base.masses, base.stiffness, damping, uplift, base.uplift_stage,
                              aero_coefficient=p["aero_coefficient_N_s2_m2"], name=base.name, sources=base.sources)
-    if p["pantograph"] != "lumped_interaction":  # scene bodies with the lumped pantograph's static contact force
-        check_scene_pantograph(p, design.stagger, design.n_sections,
-                               {} if p["pantograph"] == "lumped" else
-                               {"pantograph_damping_N_s_m": (p["pantograph_damping_N_s_m"], "0,0,0")})
-        extra = {"speed_kmh": p["speed_kmh"], "n_spans": design.line_spans, "tension_sections": design.n_sections,
-                 "wave_speed_kmh": design.wave_speed * 3.6, **as_built}
-        return run_scene_pantograph(design, p, speed, float(panto.static_force(speed).sum()), "benchmark2015", extra,
-                                    aero_force=float(panto.aero_coefficient * speed**2), lumped=panto, form=form)
-    result = run_passage(design, [panto] * p["n_pantographs"], speed, spacing=p["spacing_m"], form=form,
-                         **numerical_options(p))
-    extra = {"speed_kmh": p["speed_kmh"], "uplift_N": uplift, "n_spans": design.line_spans,
-             "tension_sections": design.n_sections,
+    # scene bodies with the lumped pantograph's static contact force
+    check_scene_pantograph(p, design.stagger, design.n_sections,
+                           {} if p["pantograph"] == "lumped" else
+                           {"pantograph_damping_N_s_m": (p["pantograph_damping_N_s_m"], "0,0,0")})
+    extra = {"speed_kmh": p["speed_kmh"], "n_spans": design.line_spans, "tension_sections": design.n_sections,
              "wave_speed_kmh": design.wave_speed * 3.6, **as_built}
-    return passage_output(result, p, "benchmark2015", extra)
+    return run_scene_pantograph(design, p, speed, float(panto.static_force(speed).sum()), "benchmark2015", extra,
+                                aero_force=float(panto.aero_coefficient * speed**2), lumped=panto, form=form)
 
 
 MODEL = Model("benchmark2015", "the 2015 pantograph-catenary benchmark: EN 50318 statistics of the contact force",

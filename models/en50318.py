@@ -29,8 +29,7 @@ penalty or, the wire being unstaggered, bilateral contact), its plunger uplift t
 the static contact force is ``static_force_N`` (the summary reports that uplift, ``uplift_N``):
 ``pantograph=lumped`` (default) the reference two-mass pantograph, ``pantograph=seo2005`` the
 seed paper's four-body pantograph (not the standard's reference pantograph: the standard's
-ranges are meant for the lumped one). ``pantograph=lumped_interaction`` runs the lumped one on
-the earlier interaction path (:mod:`symcat.interaction.passage`), kept for comparison.
+ranges are meant for the lumped one).
 
 As built: ``dropper_length_sd_m``, ``support_height_sd_m``, ``contact_wire_irregularity_m`` (with
 ``irregularity_correlation_m``) and ``deviation_seed`` build the form-found line with sampled
@@ -47,12 +46,8 @@ from symcat.interaction.model_support import (
     NUMERICAL_PARAMETERS,
     PANTOGRAPH_PARAMETER,
     check_scene_pantograph,
-    numerical_options,
-    passage_output,
     run_scene_pantograph,
-    scene_pantograph_choice,
 )
-from symcat.interaction.passage import run_passage
 from symcat.model import Model, Parameter
 from symcat.pantograph import en50318_pantograph
 
@@ -75,19 +70,12 @@ def run(p: dict):
     if not speed < design.wave_speed:
         raise ParameterError(f"speed_kmh={p['speed_kmh']:g} km/h: must be below the contact-wire wave speed "
                              f"{design.wave_speed * 3.6:.1f} km/h")
-    p = scene_pantograph_choice(p)
     form, as_built = as_built_form(design, p, p["elements_per_span"], p["element"], p["progress"])  # deviations
-    if p["pantograph"] != "lumped_interaction":  # scene bodies pressing with static_force_N
-        check_scene_pantograph(p, design.stagger)
-        extra = {"speed_kmh": p["speed_kmh"], "static_force_N": p["static_force_N"],
-                 "wave_speed_kmh": design.wave_speed * 3.6, "choices": design.sources, **as_built}
-        return run_scene_pantograph(design, p, speed, p["static_force_N"], "en50318", extra,
-                                    lumped=en50318_pantograph(p["static_force_N"]), form=form)
-    panto = en50318_pantograph(p["static_force_N"])
-    result = run_passage(design, [panto], speed, form=form, **numerical_options(p))
+    check_scene_pantograph(p, design.stagger)  # scene bodies pressing with static_force_N
     extra = {"speed_kmh": p["speed_kmh"], "static_force_N": p["static_force_N"],
              "wave_speed_kmh": design.wave_speed * 3.6, "choices": design.sources, **as_built}
-    return passage_output(result, p, "en50318", extra)
+    return run_scene_pantograph(design, p, speed, p["static_force_N"], "en50318", extra,
+                                lumped=en50318_pantograph(p["static_force_N"]), form=form)
 
 
 MODEL = Model("en50318", "EN 50318:2002 reference catenary and pantograph (250 or 300 km/h)", PARAMETERS, run)

@@ -63,8 +63,8 @@ for key, value in result.statistics[0].items():
     print(f"{key:26s} {value:10.4g}")
 
 # %%
-# The histories have the lumped passages' names (:class:`~symcat.interaction.scene_passage.SceneRecord`),
-# so ``symcat.interaction.output`` writes the same plots and ParaView series for both. The mesh
+# The histories are named with their SI units (:class:`~symcat.interaction.scene_passage.SceneRecord`),
+# and ``symcat.interaction.output`` writes the models' plots and ParaView series from them. The mesh
 # here is coarse so that the documentation builds quickly: at 10 elements per span the raw force
 # carries a ripple of the elements (5.5 m long), and on the 2015 benchmark at 320 km/h such a mesh
 # overstates the standard deviation by about 30 % (:doc:`../performance/pantograph`); the

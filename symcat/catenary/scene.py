@@ -25,10 +25,9 @@ supports                 metres straight above it: force ``preload - k (z - heig
                          preload (the spring leans, and adds a horizontal stiffness of
                          ``force / anchor``, only when the node moves along the line)
 stagger, overlaps        in the node positions (one pair of wires per tension section)
-Rayleigh damping         one :class:`RayleighDamping` on all wires: the damping
-                         matrix of :class:`~symcat.interaction.CoupledLine`, ``alpha M + beta
-                         K`` with ``M`` the structure's mass matrix (the scene's, wires and
-                         lumped masses) and ``K`` the structure's tangent stiffness at the static
+Rayleigh damping         one :class:`RayleighDamping` on all wires: the structure's damping
+                         matrix ``alpha M + beta K`` (the design's coefficients) with ``M``
+                         the structure's mass matrix (the scene's, wires and lumped masses) and ``K`` the structure's tangent stiffness at the static
                          state ``form.q`` with every dropper taut, handed over as a constant
                          matrix (``CatenaryStructure.stiffness(form.q, droppers_taut=True)``:
                          wires, droppers, vertical supports; not the scene's own tangent, whose

@@ -1,8 +1,6 @@
-"""Pantograph/catenary interaction: contact, coupled equations, time integration, statistics."""
-from .coupled import CONTACT_MODELS, CoupledLine, PantographRun
-from ..integrate.alpha_coefficients import AlphaCoefficients
-from .generalized_alpha import integrate
-from .recorder import PassageRecorder, load_passage
+"""Pantograph/catenary passages on the shared multibody path: pantographs as scene bodies under the
+catenary scene (:mod:`.scene_passage`), their EN 50318 statistics (:mod:`.statistics`), the
+passage's section and duration (:mod:`.passage`), records and outputs."""
+from .scene_record import load_passage
 
-__all__ = ["CoupledLine", "PantographRun", "CONTACT_MODELS", "integrate", "AlphaCoefficients", "PassageRecorder",
-           "load_passage"]
+__all__ = ["load_passage"]

@@ -5,7 +5,6 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model import ModelOutput, Parameter
-from .passage import PassageResult
 
 NUMERICAL_PARAMETERS = [
     Parameter("elements_per_span", 60, "-", "contact/messenger-wire elements per span (rounded per dropper interval); "
@@ -32,7 +31,9 @@ NUMERICAL_PARAMETERS = [
 
 
 def numerical_options(p: dict) -> dict:
-    """Keyword arguments of :func:`run_passage` from the shared parameters."""
+    """The shared numerical and contact parameters as keyword arguments (the names of
+    :func:`~.scene_passage.run_scene_passage`'s, with ``contact``, ``contact_stiffness`` and
+    ``contact_damping`` for the pantograph fragment)."""
     return dict(elements_per_span=p["elements_per_span"], element=p["element"], contact=p["contact"], wires=p["wires"],
                 contact_stiffness=p["contact_stiffness"], contact_damping=p["contact_damping"],
                 analysis_spans=p["analysis_spans"], dt=p["dt"], rho_inf=p["rho_inf"], tol=p["tol"],
@@ -40,7 +41,7 @@ def numerical_options(p: dict) -> dict:
                 progress=p["progress"])
 
 
-def central_span_droppers(result: PassageResult) -> list[float]:
+def central_span_droppers(result) -> list[float]:
     """Unstretched dropper lengths (m) of the span at the middle of the line."""
     st = result.form.structure
     d = st.design
@@ -49,13 +50,12 @@ def central_span_droppers(result: PassageResult) -> list[float]:
     return [float(v) for v in st.dropper_length[k * per:(k + 1) * per]]
 
 
-def passage_output(result: PassageResult, p: dict, stem: str, extra: dict | None = None) -> ModelOutput:
+def passage_output(result, p: dict, stem: str, extra: dict | None = None) -> ModelOutput:
     """Summary (EN 50318 statistics per pantograph, dropper lengths, run info) and writer.
 
-    ``result``: a :class:`~.passage.PassageResult` (lumped pantographs, interaction path) or a
-    :class:`~.scene_passage.ScenePassageResult` (a multibody pantograph on the scene path: the
-    same statistics, plots, ``.npz`` and ParaView series; entries it cannot give are listed
-    under ``not_computed`` with the reason).
+    ``result``: a :class:`~.scene_passage.ScenePassageResult` (pantographs as scene bodies, or a
+    vehicle's, :mod:`.scene_vehicle`); entries its record cannot give are listed under
+    ``not_computed`` with the reason.
     """
     form = result.form
     summary = {
@@ -73,8 +73,7 @@ def passage_output(result: PassageResult, p: dict, stem: str, extra: dict | None
         else:
             for k, s in enumerate(result.statistics):
                 summary[f"pantograph_{k + 1}"] = s
-        # static placement and time integration (the multibody path's static solve is a separate
-        # step, counted here as the interaction path's is inside its integration)
+        # static placement and time integration (the static solve is a step of its own)
         wall = rec.stats.get("passage_wall_s", rec.stats["wall_s"])
         summary["wall_per_simulated_s"] = wall / max(result.simulated_s, 1e-12)
         summary["max_penetration_m"] = float(np.max(rec.penetration_m))
@@ -85,7 +84,7 @@ def passage_output(result: PassageResult, p: dict, stem: str, extra: dict | None
             summary["energy_balance_error_J"] = float(np.abs(balance["error_J"]).max())
             summary["contact_work_J"] = balance["work_scale_J"]
         summary["slack_dropper_events"] = int(np.sum(np.diff((rec.dropper_tension_N <= 0).astype(int), axis=0) == 1))
-        if getattr(rec, "not_computed", None):  # the multibody path (scene_passage): what it does not have, and why
+        if getattr(rec, "not_computed", None):  # what this record does not have, and why
             summary["not_computed"] = dict(rec.not_computed)
     summary.update(extra or {})
     stats = dict(rec.stats) if rec is not None else {}
@@ -107,24 +106,12 @@ def passage_output(result: PassageResult, p: dict, stem: str, extra: dict | None
 
 
 #: The pantograph model of a line-scale passage (benchmark2015, en50318).
-PANTOGRAPH_CHOICES = ("lumped", "seo2005", "lumped_interaction")
+PANTOGRAPH_CHOICES = ("lumped", "seo2005")
 PANTOGRAPH_PARAMETER = Parameter(
     "pantograph", "lumped", "", "pantograph model: lumped (the model's lumped-mass pantograph as scene bodies on the "
     "multibody path) or seo2005 (the seed paper's four-body pantograph as scene bodies); their uplift is trimmed to "
-    "the static contact force, overlaps need contact=penalty; lumped_interaction: the lumped pantograph on the "
-    "earlier interaction path (its own contact model and integrator, kept for comparison; with contact=bilateral it "
-    "runs as lumped: its sliding contact is unstable on the default mesh)",
+    "the static contact force, overlaps need contact=penalty",
     choices=PANTOGRAPH_CHOICES)
-
-
-def scene_pantograph_choice(p: dict) -> dict:
-    """The model parameters ``p`` with the path that runs them: the lumped pantograph in
-    bilateral contact runs on the multibody path (``lumped``: the interaction path's sliding
-    contact goes unstable on fine meshes, 60 elements per span at 1 ms reached 1e5 N within
-    0.05 s)."""
-    if p.get("pantograph", "lumped") == "lumped_interaction" and p.get("contact") == "bilateral":
-        return {**p, "pantograph": "lumped"}
-    return p
 
 
 def check_scene_pantograph(p: dict, stagger: float, tension_sections: int = 1,
@@ -143,8 +130,6 @@ def check_scene_pantograph(p: dict, stagger: float, tension_sections: int = 1,
     lumped_only : dict, optional
         Parameter name -> (value, default) of parameters that only the lumped pantograph has.
     """
-    if p.get("pantograph", "lumped") == "lumped_interaction":
-        return
     name = f"pantograph={p['pantograph']}"
     if tension_sections != 1 and p["contact"] == "bilateral":
         raise ParameterError(f"tension_sections={tension_sections} with {name} and contact=bilateral: a sliding joint "

@@ -50,15 +50,7 @@ def _marks(ax, result, lo, hi) -> None:
 def case_title(result, stem: str) -> str:
     """The case of a passage in words: catenary, speed, pantograph(s), contact model."""
     line, design = result.line, result.form.structure.design
-    if hasattr(result, "pantograph_text"):  # a multibody pantograph (scene_passage)
-        kind = result.pantograph_text()
-    else:
-        names = [r.pantograph.name for r in line.runs]
-        panto = line.runs[0].pantograph
-        kind = f"{names[0]} pantograph ({len(panto.masses)} masses, {panto.uplift:.0f} N static uplift)"
-        if len(names) > 1:
-            spacing = abs(line.runs[0].x_start - line.runs[1].x_start)
-            kind = f"{len(names)} x {kind}, {spacing:g} m apart"
+    kind = result.pantograph_text()
     sections = f", {design.n_sections} tension sections" if design.n_sections > 1 else ""
     presag = 1e3 * max(design.presag) if len(design.presag) else 0.0
     return (f"{stem}: {line.speed * 3.6:g} km/h, {kind}, {line.contact} contact\n"

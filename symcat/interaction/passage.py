@@ -1,52 +1,20 @@
-"""One call from a catenary design and pantographs to EN 50318 statistics.
+"""Where a line passage runs and what it is judged on, whatever the pantograph model.
 
-:func:`run_passage` does form finding, places the pantographs in static contact, integrates
-the passage over the analysis section and returns the recorder and the statistics per
-pantograph. The analysis section is ``analysis_spans`` whole spans; each pantograph is
-evaluated while it crosses it, so the run lasts until the last pantograph has left it.
+:func:`passage_plan` places the analysis section (``analysis_spans`` whole spans), the start of
+the pantographs and the duration: each pantograph is evaluated while it crosses the section, so
+the run lasts until the last one has left it. :func:`spans_needed` is the shortest line for a
+train, and :func:`pantograph_statistics` the EN 50318 statistics of one pantograph's run
+(:func:`~.scene_passage.run_scene_passage` and :mod:`.scene_vehicle` use them).
 """
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..catenary.design import CatenaryDesign
-from ..catenary.formfinding import FormFindingResult, find_form
 from ..errors import ParameterError
-from ..pantograph.lumped import LumpedPantograph
-from .coupled import CoupledLine, PantographRun
-from .generalized_alpha import integrate
-from .recorder import PassageRecorder
 from .statistics import STAT_KEYS, contact_statistics
-
-
-@dataclass
-class PassageResult:
-    """Outcome of :func:`run_passage`.
-
-    Attributes
-    ----------
-    form : FormFindingResult
-    line : CoupledLine
-    record : PassageRecorder or None (static only)
-    section_m : (float, float)
-        Analysis section along the line (m).
-    statistics : list of dict
-        EN 50318 statistics per pantograph (keys of ``STAT_KEYS``).
-    wall_s : float
-        Wall time of the whole run (s).
-    """
-
-    form: FormFindingResult
-    line: CoupledLine
-    record: PassageRecorder | None
-    section_m: tuple[float, float]
-    statistics: list[dict] = field(default_factory=list)
-    wall_s: float = 0.0
-    simulated_s: float = 0.0
 
 
 #: Time (s) the run continues past the analysis section so the filtered force there is settled.
@@ -87,9 +55,17 @@ def passage_plan(design: CatenaryDesign, n_pantographs: int, speed: float, spaci
         Pantographs, ``spacing`` (m) apart (the first leads).
     speed : float
         Train speed (m/s).
-    spacing, analysis_spans, lead_in, t_end
-        As :func:`run_passage` (m, -, m, s); ``t_end=None``: until the last pantograph has
-        left the analysis section and ``SETTLE_S`` more.
+    spacing : float
+        Distance (m) between consecutive pantographs.
+    analysis_spans : int
+        Spans of the analysis section: the central ones when every pantograph fits on the line
+        before it, otherwise the last ones the leading pantograph can cross before the final span.
+    lead_in : float, optional
+        Run (m) of the trailing pantograph before the section (default: one span), for the
+        start-up transient to pass.
+    t_end : float, optional
+        Simulated time (s); None: until the last pantograph has left the analysis section and
+        ``SETTLE_S`` more; 0: the static state only.
 
     Returns
     -------
@@ -159,40 +135,3 @@ def pantograph_statistics(t: np.ndarray, x_contact: np.ndarray, force: np.ndarra
     st = structure
     return contact_statistics(t, x_contact, force, section, st.x[st.support_nodes], support_z, static_support_z)
 
-
-def run_passage(design: CatenaryDesign, pantographs: list[LumpedPantograph], speed: float, spacing: float = 200.0,
-                elements_per_span: int = 60, element: str = "cable3d", contact: str = "penalty",
-                contact_stiffness: float = 5.0e4, contact_damping: float = 0.0, analysis_spans: int = 2,
-                lead_in: float | None = None, dt: float = 1e-3, rho_inf: float = 0.8, tol: float = 1e-4,
-                t_end: float | None = None, record_every: float = 0.01, progress: bool = True,
-                form: FormFindingResult | None = None, wires: str = "nonlinear") -> PassageResult:
-    """Form-find ``design``, run ``pantographs`` over it at ``speed`` (m/s), return statistics.
-
-    The first pantograph in the list leads; each follows the one in front at ``spacing`` (m), so
-    ``statistics[0]`` (``pantograph_1`` in model summaries) is the leading one.
-    The trailing pantograph starts ``lead_in`` (default: one span) before the analysis section,
-    which is the central ``analysis_spans`` spans when every pantograph fits on the line, and
-    otherwise the last spans the leading pantograph can cross before the final span. ``t_end``
-    (s) overrides the duration; ``t_end=0`` computes the static state only. ``wires="linear"``
-    linearizes the wires' elastic forces about the static catenary (droppers, supports and
-    contact stay nonlinear).
-    """
-    t0 = time.perf_counter()
-    if not pantographs:
-        raise ParameterError("pantographs: need at least one")
-    section, x_trail, duration = passage_plan(design, len(pantographs), speed, spacing, analysis_spans, lead_in, t_end)
-    x_lead = x_trail + spacing * (len(pantographs) - 1)
-    runs = [PantographRun(p, x_lead - k * spacing) for k, p in enumerate(pantographs)]
-    if wires not in ("nonlinear", "linear"):
-        raise ParameterError(f"wires={wires!r}: must be nonlinear or linear")
-    if form is None:
-        form = find_form(design, elements_per_span, element, progress=progress)
-    form.structure.linearize_wires(form.q if wires == "linear" else None)
-    line = CoupledLine(form, runs, speed, contact, contact_stiffness, contact_damping)
-    if duration == 0:
-        y, fc = line.static_state()
-        return PassageResult(form, line, None, section, [], time.perf_counter() - t0, 0.0)
-    rec = integrate(line, duration, dt=dt, rho_inf=rho_inf, tol=tol, record_every=record_every, progress=progress)
-    stats = [pantograph_statistics(rec.t_s, rec.x_contact_m[:, p], rec.contact_force_N[:, p], section, form.structure,
-                                   rec.support_z_m, rec.static_support_z_m) for p in range(len(runs))]
-    return PassageResult(form, line, rec, section, stats, time.perf_counter() - t0, duration)

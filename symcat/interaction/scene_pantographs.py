@@ -89,11 +89,10 @@ def lumped_fragment(pantograph, contact: str = "penalty", contact_stiffness: flo
                     form: FormFindingResult | None = None, name: str = "pantograph") -> ScenePantograph:
     """A lumped-mass pantograph (:class:`~symcat.pantograph.LumpedPantograph`: its stages,
     springs, dampers, uplift and aerodynamic force) as scene bodies
-    (:func:`symcat.pantograph.lumped_scene.add_lumped_pantograph`), a :class:`ScenePantograph`:
-    the interaction path's pantograph on the shared multibody path. The trimmed uplift replaces
-    ``pantograph.uplift``. With the catenary's ``form``, the pan-head is placed as the
-    interaction path places it (on the wire's static height under its static force,
-    :func:`~symcat.pantograph.lumped_scene.loaded_wire_height`), so that the nominal uplift gives
+    (:func:`symcat.pantograph.lumped_scene.add_lumped_pantograph`), a :class:`ScenePantograph`.
+    The trimmed uplift replaces ``pantograph.uplift``. With the catenary's ``form``, the pan-head
+    is placed on the wire's static height under the pantograph's static force
+    (:func:`~symcat.pantograph.lumped_scene.loaded_wire_height`), so that the nominal uplift gives
     the static force and the trim takes one static solve. ``name`` prefixes its elements (two
     pantographs on one line need two names)."""
     from dataclasses import replace
@@ -146,7 +145,7 @@ def static_force(eq, element) -> float:
 def running_contact_wire(form: FormFindingResult, x: float) -> str:
     """Scene name of the contact wire in running at ``x`` (m): the lowest one there in the
     static catenary (the one a pan-head at ``x`` touches)."""
-    from .contact import contact_wire_locators, running_wire
+    from ..catenary.contact_wire import contact_wire_locators, running_wire
 
     st = form.structure
     return st.contacts[running_wire(st, contact_wire_locators(st), np.asarray(form.q, float), x)].name

@@ -1,17 +1,17 @@
 """A line-scale passage of any multibody pantograph under the form-found catenary, on the shared
-multibody pipeline, with the same EN 50318 statistics as :func:`~.passage.run_passage`.
+multibody pipeline, with EN 50318 statistics of its contact force.
 
 :func:`run_scene_passage` form-finds the catenary (:func:`~symcat.catenary.find_form`), turns it
 into a :class:`~symcat.scene.Scene` (:func:`~symcat.catenary.scene.catenary_scene`), adds a
-pantograph *scene fragment* under the contact wire at the start position of the lumped passage
-(:func:`~.passage.passage_plan`: the same analysis section, lead-in and duration), trims the
+pantograph *scene fragment* under the contact wire at the passage's start position
+(:func:`~.passage.passage_plan`: the analysis section, lead-in and duration), trims the
 pantograph's uplift so that the static contact force is the target, starts from the joint static
 equilibrium (:func:`~symcat.analysis.equilibrium.solve_equilibrium`) and integrates by
 generalized-alpha (:func:`symcat.integrate.generalized_alpha`, one output per step). The contact
-force history goes through the same statistics function as the lumped passage
-(:func:`~.passage.pantograph_statistics`), and the histories are recorded under the same names
-as :class:`~.recorder.PassageRecorder`'s (:class:`SceneRecord`), so that the summary, the plots,
-the ``.npz`` and the ParaView series of :func:`~.model_support.passage_output` serve both paths.
+force history goes through the statistics function of every passage
+(:func:`~.passage.pantograph_statistics`), and the histories are recorded under names with
+their SI units (:class:`SceneRecord`) for the summary, the plots, the ``.npz`` and the ParaView
+series of :func:`~.model_support.passage_output`.
 
 Your own pantograph
 -------------------
@@ -117,7 +117,7 @@ class SceneLine:
 @dataclass
 class ScenePassageResult:
     """Outcome of :func:`run_scene_passage` (the fields :func:`~.model_support.passage_output`
-    reads, as :class:`~.passage.PassageResult`'s).
+    reads).
 
     Attributes
     ----------
@@ -175,7 +175,8 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
                       form: FormFindingResult | None = None, wire: str = "contact", contact: str = "penalty",
                       force_rtol: float = 1e-5, spacing: float = 200.0, wires: str = "nonlinear") -> ScenePassageResult:
     """Run a multibody ``pantograph`` over the form-found ``design`` at ``speed`` (m/s) with the
-    static contact force ``target_force`` (N); EN 50318 statistics as :func:`~.passage.run_passage`.
+    static contact force ``target_force`` (N); EN 50318 statistics of each pantograph's contact
+    force over the analysis section.
 
     Parameters
     ----------
@@ -187,9 +188,14 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
         Train speed (m/s), > 0.
     target_force : float
         Static contact force (N) the uplift is trimmed to.
-    elements_per_span, element, analysis_spans, lead_in, t_end
-        As :func:`~.passage.run_passage`: the same section, start position (the lumped
-        passage's) and duration (s; ``t_end=0``: the static state only).
+    elements_per_span : int
+        Wire elements per span of the form finding (unused with ``form``).
+    element : str
+        ANCF element of the wires (``"cable3d"`` or ``"beam3d"``).
+    analysis_spans, lead_in, t_end
+        The analysis section, the run before it (m) and the duration (s; None: until the last
+        pantograph has left the section; ``t_end=0``: the static state only), as
+        :func:`~.passage.passage_plan` places them.
     dt, rho_inf : float
         Generalized-alpha step (s) and spectral radius at infinity.
     tol : float
@@ -210,10 +216,10 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
         the statistics resolve; each further digit may cost a static solve).
     spacing : float
         Distance (m) between pantographs when ``pantograph`` is a list (leading first, as
-        :func:`~.passage.run_passage` places them; penalty contacts, distinct element names).
+        :func:`~.passage.passage_plan` places them; penalty contacts, distinct element names).
     wires : {"nonlinear", "linear"}
         The wires' elasticity: ANCF, or linearized about the static catenary without
-        pantographs (:func:`~symcat.catenary.scene.catenary_scene`; as ``run_passage``'s).
+        pantographs (:func:`~symcat.catenary.scene.catenary_scene`).
 
     Returns
     -------
@@ -233,7 +239,7 @@ def run_scene_passage(design: CatenaryDesign, pantograph: ScenePantograph, speed
     positions = [x_trail + spacing * (n_p - 1 - k) for k in range(n_p)]  # leading first
     if form is None:
         form = find_form(design, elements_per_span, element, progress=progress)
-    placed0 = time.perf_counter()  # the passage's wall: static placement and integration, as run_passage's
+    placed0 = time.perf_counter()  # the passage's wall: static placement and integration
     if progress:
         notice(f"trimming the uplift of the {pantographs[0].name} pantograph{'s' if n_p > 1 else ''} to a static "
                f"contact force of {target_force:g} N (static solves of the joint equilibrium)")

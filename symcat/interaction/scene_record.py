@@ -1,7 +1,7 @@
 """The records of a multibody line passage (:mod:`.scene_passage`): the per-step monitor of its
-penalty contacts, the histories read from a run's outputs, and :class:`SceneRecord`, which holds
-them under the interaction path's names so that one set of statistics, plots and files serves
-both paths."""
+penalty contacts, the histories read from a run's outputs, :class:`SceneRecord`, which holds them
+under names with their SI units for the statistics, plots and files, and :func:`load_passage`,
+which reads a saved record back."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -22,7 +22,7 @@ NOT_COMPUTED = {
 
 
 class SceneRecord:
-    """Histories of a :func:`~.scene_passage.run_scene_passage`, under :class:`~.recorder.PassageRecorder`'s names
+    """Histories of a :func:`~.scene_passage.run_scene_passage`, named with their SI units
     (``p`` pantographs, leading first; ``w`` contact wires of the tension sections). The
     attributes are NumPy arrays, SI units in the names.
 
@@ -84,8 +84,8 @@ class SceneRecord:
         return balance(self.t_s, self.work_power_W, -np.asarray(self.dissipation_power_W), self.t_s[at], e[at])
 
     def arrays(self) -> dict[str, np.ndarray]:
-        """Every recorded array by name (as :meth:`PassageRecorder.arrays`, without the
-        per-step iterations)."""
+        """Every recorded array by name (SI units in the names), with the catenary's stations,
+        supports, droppers, static support heights and the speed."""
         st = self._form.structure
         out = dict(self._arrays)
         out.update(station_x_m=st.x, support_x_m=st.x[st.support_nodes], dropper_x_m=st.x[st.dropper_nodes],
@@ -94,11 +94,18 @@ class SceneRecord:
         return out
 
     def save(self, path) -> Path:
-        """Write every array to ``path`` (.npz; :func:`~.recorder.load_passage` reads it)."""
+        """Write every array to ``path`` (.npz; :func:`load_passage` reads it)."""
         path = Path(path)
         np.savez_compressed(path, **self.arrays())
         return path
 
+
+
+def load_passage(path) -> dict[str, np.ndarray]:
+    """Read a passage saved by :meth:`SceneRecord.save` back as a dict of named arrays (units in
+    the names)."""
+    with np.load(path) as data:
+        return {k: data[k] for k in data.files}
 
 def _monitor(form, model, elements, energy, snapshot_every: float):
     """Per-step records of the penalty contacts' passage (generalized-alpha's ``monitor``, of

@@ -6,7 +6,7 @@ Mapping (``name`` = the ``name`` argument; stage 0 sits on the roof, the last st
 pan-head):
 
 ====================================  ==================================================================
-:class:`~symcat.interaction.CoupledLine`   scene element
+:class:`LumpedPantograph`             scene element
 ====================================  ==================================================================
 pan-head position ``x_start + v t``   rigid body ``{name}_carrier`` holding y, z and its rotation
                                       (``RigidBody.held``), a :class:`Driving` along x at ``speed``
@@ -23,15 +23,15 @@ static uplift + ``aero v^2``          :class:`PointLoad` ``{name}_uplift`` (stag
                                       ``{name}_aero`` (pan-head), constant
 gravity left out                      :class:`PointLoad` ``{name}_weight_{i}`` = ``+m_i g`` on every
                                       stage: cancels the scene's gravity exactly
-reference height ``z_ref``            the spring free lengths: the springs carry, in the initial
+reference height                      the spring free lengths: the springs carry, in the initial
                                       configuration, the static forces of the pressing pantograph
                                       (stage ``j``'s spring is compressed by the static forces on the
                                       stages below it), and the pan-head is placed at ``head_z``
                                       (default: the contact-wire height at ``x0`` in the scene, or the
-                                      height under the static load from :func:`loaded_wire_height`,
-                                      which repeats ``CoupledLine._place_pantographs``)
+                                      height under the static load from :func:`loaded_wire_height`:
+                                      the catenary's static state under the pantograph's point force)
 penalty ``max(k d + c d', 0)``        :class:`PenaltyContact` ``{name}_contact`` (pan-head centre of
-                                      mass), same ``stiffness`` and ``damping``
+                                      mass), ``stiffness`` and ``damping``
 bilateral ``d = 0``                   :class:`SlidingJoint` ``{name}_contact`` on a shoe ``{name}_shoe``
                                       that slides across the pan-head (:class:`Prismatic` along y),
                                       because the joint also fixes the lateral position and the wire
@@ -39,27 +39,23 @@ bilateral ``d = 0``                   :class:`SlidingJoint` ``{name}_contact`` o
                                       mass (vertical mass unchanged; the wire gets that lateral mass)
 ====================================  ==================================================================
 
-Differences that remain (physics not identical):
+Modelling choices of the contact:
 
-* Penalty law: the scene's law is C1-smoothed over ``smoothing`` (m): in contact it is
-  ``k (pen - smoothing) + c pen'`` (not ``k pen + c pen'``), quadratic below ``2 smoothing``
-  and exactly zero once separated (interaction path: a kink at ``pen = 0``). The static state
-  absorbs the offset (the pan-head sits ``smoothing`` deeper: :func:`add_lumped_pantograph`
-  places it so); only contact loss and re-contact see a difference, of order ``k smoothing``
-  (0.5 N at 5e4 N/m and 1e-5 m).
-* Contact point: interaction path: the wire point in the vertical plane ``x = x_c`` and the
-  vertical penetration; force vertical on both. Scene: the wire point whose tangent is normal
-  to the segment from the pan-head point (tangency condition), the penetration and force along
-  the wire's normal ``k_t`` (in the xz-plane): the force has a horizontal part ``f dz/dx`` on
-  the wire and on the pan-head (taken by the carrier's guide). Differences of order
-  ``(dz/dx)^2`` in the gap and ``dz/dx`` in the force direction (wire slopes of a few 1e-3).
-  The wire's stagger (lateral zigzag) is ignored by both (the normal has no y component;
-  the tangency condition shifts the point along x by ``stagger * dy/dx``, about a millimetre).
-* Penetration rate: interaction path ``u_head' - w . z_wire' - (dz/dx) v``; the scene
-  differentiates its normal gap exactly (the same to first order in the slope).
-* Section overlaps: the interaction path presses a pan-head on every contact wire above it;
-  here one contact element per call (call again with the other wire's name in an overlap:
-  each contact is zero when separated).
+* Penalty law: C1-smoothed over ``smoothing`` (m): in contact it is ``k (pen - smoothing) + c
+  pen'`` (not ``k pen + c pen'``), quadratic below ``2 smoothing`` and exactly zero once
+  separated (no kink at ``pen = 0`` for Newton's method to stumble on). The static state absorbs
+  the offset (the pan-head sits ``smoothing`` deeper: :func:`add_lumped_pantograph` places it
+  so); only contact loss and re-contact see it, of order ``k smoothing`` (0.5 N at 5e4 N/m and
+  1e-5 m).
+* Contact point: the wire point whose tangent is normal to the segment from the pan-head point
+  (tangency condition); the penetration and force act along the wire's normal ``k_t`` (in the
+  xz-plane), so the force has a horizontal part ``f dz/dx`` on the wire and on the pan-head
+  (taken by the carrier's guide), of the order of the wire's slope (a few 1e-3). The wire's
+  stagger (lateral zigzag) does not enter the normal (no y component); the tangency condition
+  shifts the point along x by ``stagger * dy/dx``, about a millimetre.
+* Penetration rate: the exact time derivative of the normal gap.
+* Section overlaps: one contact element per call (call again with the other wire's name in an
+  overlap: each contact is zero when separated).
 """
 from __future__ import annotations
 
@@ -99,8 +95,8 @@ def wire_height(scene: Scene, wire: str, x: float) -> tuple[float, float, float]
     xs, zs = q0[:, ix], q0[:, iz]
     if not xs[0] <= x <= xs[-1]:
         raise ParameterError(f"x={x:g} m: off the wire {wire!r} ({xs[0]:g}..{xs[-1]:g} m)")
-    # cubic Hermite on the element, as the interaction path's WireLocator
-    from ..interaction.contact import hermite
+    # cubic Hermite on the element, as the structure's WireLocator (symcat.catenary.contact_wire)
+    from ..catenary.contact_wire import hermite
     k = int(np.clip(np.searchsorted(xs, x, side="right") - 1, 0, len(xs) - 2))
     ixx, izx = body.coordinate_index("x_x"), body.coordinate_index("z_x")
     length = float(np.linalg.norm(q0[k + 1, [ix, body.coordinate_index("y"), iz]] - q0[k, [ix, body.coordinate_index("y"), iz]]))
@@ -121,7 +117,7 @@ def wire_height(scene: Scene, wire: str, x: float) -> tuple[float, float, float]
 def running_sections(form, xs) -> list[int]:
     """The contact wire in running (the lowest) at each ``x`` (m) of ``xs`` in the static
     catenary ``form`` (indices of ``form.structure.contacts``)."""
-    from ..interaction.contact import contact_wire_locators, running_wire
+    from ..catenary.contact_wire import contact_wire_locators, running_wire
 
     st = form.structure
     _check_covered(st, xs)
@@ -141,7 +137,7 @@ def loaded_catenary(form, xs, forces, sections=None) -> np.ndarray:
     :func:`running_sections`), by ``coupled_equilibrium``. Kept on ``form`` for the same loads
     (a pantograph's placement and the static solve's starting state ask for the same state)."""
     from ..catenary.formfinding import coupled_equilibrium
-    from ..interaction.contact import contact_wire_locators, point_loads
+    from ..catenary.contact_wire import contact_wire_locators, point_loads
 
     st = form.structure
     xs, forces = [float(x) for x in xs], [float(f) for f in forces]
@@ -179,11 +175,11 @@ def _loaded_start(form, kept: dict, key: tuple) -> np.ndarray:
 
 def loaded_wire_height(form, x: float, force: float, section: int | None = None, state=None) -> float:
     """Height (m) of the contact wire at ``x`` in the static state of the catenary ``form``
-    pressed up by ``force`` (N) at ``x``: what ``CoupledLine._place_pantographs`` solves (the
+    pressed up by ``force`` (N) at ``x``: where a pantograph pressing with that force stands (the
     structure's static equilibrium under the point load, :func:`loaded_catenary`). ``state``:
     the catenary's coordinates to read the height from instead (a static state under several
     pantographs' forces, ``force`` then unused)."""
-    from ..interaction.contact import contact_wire_locators
+    from ..catenary.contact_wire import contact_wire_locators
 
     _check_covered(form.structure, [x])
     section = running_sections(form, [x])[0] if section is None else section
@@ -202,13 +198,13 @@ def add_lumped_pantograph(scene: Scene, pantograph: LumpedPantograph, wire: str,
     ----------
     contact : "penalty" or "bilateral"
     contact_stiffness, contact_damping : float
-        Penalty law (N/m, N s/m), as ``run_passage``'s.
+        Penalty law (N/m, N s/m).
     smoothing : float
         Smoothing depth (m) of the scene's penalty law.
     head_z : float, optional
         Height (m) of the pan-head's contact point along the wire in the static state (default:
         the wire's height at ``x0`` in the scene's initial configuration; pass
-        :func:`loaded_wire_height` for the exact static state of the interaction path). The
+        :func:`loaded_wire_height` for the catenary's static state under the pantograph). The
         pan-head is placed ``force / k + smoothing`` above it (penalty) or on it (bilateral),
         with the springs preloaded for the static force ``sum(static_force(speed))``.
     y : float

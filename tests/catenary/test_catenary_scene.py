@@ -212,7 +212,8 @@ def _jacobians(model, q):
 
 
 def _structure_damping(st, q):
-    """CatenaryStructure's Rayleigh matrix as CoupledLine builds it (all coordinates)."""
+    """The structure's own Rayleigh matrix ``alpha M + beta K0`` (its mass matrix and its
+    stiffness at ``q`` with every dropper taut, all coordinates)."""
     d = st.design
     return (d.rayleigh_alpha * st.mass_matrix + d.rayleigh_beta * st.stiffness(q, droppers_taut=True)).toarray()
 

@@ -1,6 +1,6 @@
-"""The line-scale passages reproduce their saved statistics (tests/models/passage_baseline.py):
-the guard of their move onto the shared multibody pipeline (issue 28), and of any change that
-moves them. Mean and standard deviation of the contact force within 0.5 %, the other
+"""The line-scale passages reproduce their saved statistics (tests/models/passage_baseline.py,
+saved from the retired interaction path): the guard of their move onto the shared multibody
+pipeline (issue 28), and of any change that moves them. Mean and standard deviation of the contact force within 0.5 %, the other
 statistics within 2 % (of the force's standard deviation for force extremes near zero; 0.1
 percentage points of contact loss)."""
 from __future__ import annotations
@@ -42,16 +42,6 @@ def test_passage_statistics_match_the_saved_baseline(name):
     model, params = CASES[name]
     summary = run_model(model, {**params, "progress": False}).summary
     assert summary["pantograph"] == "lumped" and summary["uplift_static_solves"] <= 3
-    _assert_matches(statistics(summary), BASELINE[name]["statistics"])
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("name", sorted(CASES))
-def test_the_interaction_path_keeps_the_saved_baseline(name):
-    """``pantograph=lumped_interaction``: the earlier interaction path that saved the baseline
-    (kept for comparison until it is retired) still reproduces it."""
-    model, params = CASES[name]
-    summary = run_model(model, {**params, "pantograph": "lumped_interaction", "progress": False}).summary
     _assert_matches(statistics(summary), BASELINE[name]["statistics"])
 
 

@@ -1,4 +1,7 @@
-"""Where a pan-head touches the contact wire, and the wire's height there as weights on q.
+"""Where a pan-head touches the contact wire of a form-found catenary, and the wire's height
+there as weights on the structure's coordinates ``q``: the static placement of pantographs
+(:func:`~symcat.pantograph.lumped_scene.loaded_catenary`, the wire in running at a point) reads
+the wire through these.
 
 The pan-head is a horizontal strip across the track at ``x_c``; it touches the wire where the
 wire crosses the plane x = x_c. On the cubic ANCF element containing that point the position is
@@ -102,7 +105,7 @@ def running_wire(structure, locators: list[WireLocator], q: np.ndarray, x: float
 def point_loads(n: int, locators: list[WireLocator], wires, xs, forces):
     """``q -> (f, None)``: upward point forces ``forces`` (N) on the contact wires ``wires`` at
     ``xs`` (m), as generalized forces on the ``n`` coordinates (the ``extra`` of
-    :func:`~symcat.catenary.coupled_equilibrium`)."""
+    :func:`~symcat.catenary.formfinding.coupled_equilibrium`)."""
     def loads(q):
         f = np.zeros(n)
         for x, force, w in zip(xs, forces, wires):
