@@ -129,17 +129,24 @@ _SUBPROCESS = ("import json, sys\n"
                "print(json.dumps(summary, default=str))\n")
 
 
-def interaction_model(checkout: Path, params: dict, optimize: str = "background") -> dict:
-    """Summary of the model benchmark2015 on the interaction path (``pantograph=lumped_interaction``)
-    with ``params`` (320 km/h unless they say otherwise), run by this Python in a subprocess on
-    the code of ``checkout`` (:func:`interaction_checkout`) with ``SYMCAT_OPTIMIZE=optimize``."""
-    params = {"speed_kmh": 320.0, **params, "pantograph": "lumped_interaction", "progress": False, "paraview": False}
+def model_in_subprocess(checkout: Path, params: dict, optimize: str = "background") -> dict:
+    """Summary of the model benchmark2015 with ``params`` (320 km/h unless they say otherwise),
+    run by this Python in a fresh process on the code of ``checkout`` with
+    ``SYMCAT_OPTIMIZE=optimize``: as a user runs it (``symcat run``), nothing kept from earlier
+    runs but the disk cache."""
+    params = {"speed_kmh": 320.0, **params, "progress": False, "paraview": False}
     env = {**os.environ, "PYTHONPATH": str(checkout), "SYMCAT_OPTIMIZE": optimize}
     done = subprocess.run([sys.executable, "-c", _SUBPROCESS, json.dumps(params)], cwd=checkout, env=env,
                           capture_output=True, text=True)
     if done.returncode != 0:
-        raise RuntimeError(f"the interaction path at {checkout.name} failed with {params}:\n{done.stderr[-2000:]}")
+        raise RuntimeError(f"benchmark2015 at {checkout.name} failed with {params}:\n{done.stderr[-2000:]}")
     return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def interaction_model(checkout: Path, params: dict, optimize: str = "background") -> dict:
+    """:func:`model_in_subprocess` on the interaction path (``pantograph=lumped_interaction``) of
+    ``checkout`` (:func:`interaction_checkout`)."""
+    return model_in_subprocess(checkout, {**params, "pantograph": "lumped_interaction"}, optimize)
 
 
 #: The cases of the speed comparison: label -> model parameters.
@@ -156,9 +163,9 @@ def unified_paths(repeats: int = 3, cases=None) -> list[str]:
     """The model benchmark2015 on the interaction path (``pantograph=lumped_interaction`` at
     :data:`INTERACTION_COMMIT`, :func:`interaction_model`) and on the shared multibody path
     (``lumped``, the default: the same pantograph as scene bodies, generalized-alpha on the
-    catenary scene), interleaved runs in this bench run, medians of ``repeats``: statistics
-    apart and the ratio of wall per simulated second (static placement and time integration on
-    both paths), the multibody path's with its compiled steps (built in the background after a
+    catenary scene), interleaved runs in this bench run, each in a fresh process, medians of
+    ``repeats``: statistics apart and the ratio of wall per simulated second (static placement
+    and time integration on both paths), the multibody path's with its compiled steps (built in the background after a
     first run) and, in the last column, with its Python steps (a first run on a machine).
     ``cases``: (label, parameters) pairs (default :data:`UNIFIED_CASES`)."""
     from symcat.codegen.optimized import wait_for_background
@@ -181,11 +188,9 @@ def unified_paths(repeats: int = 3, cases=None) -> list[str]:
                 python_steps = _model(params)["wall_per_simulated_s"]
             for _ in range(repeats):
                 for path in walls:
-                    if path == "interaction":
-                        summary = interaction_model(checkout, params)
-                    else:
-                        with mock.patch.dict(os.environ, {"SYMCAT_OPTIMIZE": "background"}):
-                            summary = _model(params)
+                    # each run in a process of its own, as users run the model
+                    summary = (interaction_model(checkout, params) if path == "interaction" else
+                               model_in_subprocess(REPO, params))
                     walls[path].append(summary["wall_per_simulated_s"])
                     stats[path] = {k: _pantograph_stats(summary)[k] for k in keys}
             a, b = stats["interaction"], stats["multibody"]

@@ -1,6 +1,5 @@
-"""The coefficients of the generalized-alpha method (Chung and Hulbert 1993), shared by the
-multibody integrator (:mod:`symcat.integrate.generalized_alpha`) and the line-scale passage
-(:mod:`symcat.interaction.generalized_alpha`)."""
+"""The coefficients of the generalized-alpha method (Chung and Hulbert 1993) of the multibody
+integrator (:mod:`symcat.integrate.generalized_alpha`), its Python and compiled steps."""
 from __future__ import annotations
 
 from dataclasses import dataclass
