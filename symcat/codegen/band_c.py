@@ -93,6 +93,90 @@ const casadi_int* {solve}_sparsity_out(casadi_int i) {{ return {solve}_sp; }}
 """
 
 
+
+_ENVELOPE = r"""
+/* symcat envelope band kernels: n = {n}, half-bandwidth {bw} (symcat.codegen.band_c) */
+#ifndef casadi_real
+#define casadi_real double
+#endif
+#ifndef casadi_int
+#define casadi_int long long int
+#endif
+static const casadi_int {lu}_sp[2][3] = {{{{{band}, 1, 1}}, {{{size}, 1, 1}}}};
+static const casadi_int {solve}_sp[] = {{{n}, 1, 1}};
+
+/* band -> factor: column-major band storage, a[i][j] at j (2 bw + 1) + i - j + bw; L unit
+   lower below the diagonal, U on and above it; then per column k the last row of L's column
+   (last[k]) and the first row of U's (top[k]), as numbers. Only the envelope is visited: row
+   i from its first nonzero, column j from its first nonzero (from the values: an entry that
+   is zero outside them stays zero, its products with the pivots' rows and columns zeros). */
+int {lu}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
+  const casadi_int n = {n}, bw = {bw}, wd = 2 * {bw} + 1;
+  casadi_int i, j, k, lo, end, right;
+  casadi_real *a = res[0], *last, *top, inv, ukj;
+  casadi_real *restrict ck, *restrict cj;
+  if (!a) return 0;
+  last = a + n * wd, top = last + n;
+  for (i = 0; i < n * wd; ++i) a[i] = arg[0] ? arg[0][i] : 0;
+  for (k = 0; k < n; ++k) last[k] = top[k] = k;
+  for (j = 0; j < n; ++j) {{  /* the first nonzero of column j above the diagonal */
+    for (i = j - bw > 0 ? j - bw : 0; i < j; ++i) if (a[j * wd + i - j + bw] != 0) break;
+    top[j] = i;
+  }}
+  for (i = 0; i < n; ++i) {{  /* row i's first nonzero left of the diagonal: L's columns reach row i */
+    for (lo = i - bw > 0 ? i - bw : 0; lo < i; ++lo) if (a[lo * wd + i - lo + bw] != 0) break;
+    for (k = lo; k < i; ++k) last[k] = i;  /* (i increasing: the last such row) */
+  }}
+  for (k = 0; k < n; ++k) {{
+    end = (casadi_int) last[k] + 1;
+    for (right = k, j = k + 1; j < n && j <= k + bw; ++j) if ((casadi_int) top[j] <= k) right = j;
+    ck = a + k * wd + bw - k;  /* column k: a[i][k] at ck[i] */
+    inv = 1 / ck[k];
+    for (i = k + 1; i < end; ++i) ck[i] *= inv;
+    for (j = k + 1; j <= right; ++j) {{
+      cj = a + j * wd + bw - j;
+      ukj = cj[k];
+      for (i = k + 1; i < end; ++i) cj[i] -= ck[i] * ukj;
+    }}
+  }}
+  return 0;
+}}
+
+/* (factor, b) -> x: L z = b, then U x = z, by columns (each column's entries contiguous, its
+   updates independent) over the envelope */
+int {solve}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
+  const casadi_int n = {n}, bw = {bw}, wd = 2 * {bw} + 1;
+  casadi_int i, j, end;
+  const casadi_real *restrict lu = arg[0], *restrict b = arg[1], *last, *top, *restrict cj;
+  casadi_real *restrict x = res[0], xj;
+  if (!x) return 0;
+  for (i = 0; i < n; ++i) x[i] = b ? b[i] : 0;
+  if (!lu) return 0;
+  last = lu + n * wd, top = last + n;
+  for (j = 0; j < n; ++j) {{
+    cj = lu + j * wd + bw - j;
+    xj = x[j];
+    end = (casadi_int) last[j] + 1;
+    for (i = j + 1; i < end; ++i) x[i] -= cj[i] * xj;
+  }}
+  for (j = n - 1; j >= 0; --j) {{
+    cj = lu + j * wd + bw - j;
+    xj = x[j] /= cj[j];
+    for (i = (casadi_int) top[j]; i < j; ++i) x[i] -= cj[i] * xj;
+  }}
+  return 0;
+}}
+
+casadi_int {lu}_n_in(void) {{ return 1; }}
+casadi_int {lu}_n_out(void) {{ return 1; }}
+const casadi_int* {lu}_sparsity_in(casadi_int i) {{ return {lu}_sp[0]; }}
+const casadi_int* {lu}_sparsity_out(casadi_int i) {{ return {lu}_sp[1]; }}
+casadi_int {solve}_n_in(void) {{ return 2; }}
+casadi_int {solve}_n_out(void) {{ return 1; }}
+const casadi_int* {solve}_sparsity_in(casadi_int i) {{ return i == 0 ? {lu}_sp[1] : {solve}_sp; }}
+const casadi_int* {solve}_sparsity_out(casadi_int i) {{ return {solve}_sp; }}
+"""
+
 _MATVEC = r"""
 /* symcat dense product: y = A x, A {m} x {n} column-major (symcat.codegen.band_c) */
 #ifndef casadi_real
@@ -172,6 +256,40 @@ def band_functions(n: int, bw: int) -> tuple[ca.Function, ca.Function]:
     compiled library (cached on disk under the source's digest)."""
     lu, solve = names(n, bw)
     target = _library(source(n, bw))
+    return ca.external(lu, str(target)), ca.external(solve, str(target))
+
+
+def envelope_names(n: int, bw: int) -> tuple[str, str]:
+    """The C names of :func:`envelope_functions`' factorization and solve."""
+    return f"symcat_envband_lu_{n}_{bw}", f"symcat_envband_solve_{n}_{bw}"
+
+
+def envelope_size(n: int, bw: int) -> int:
+    """The size of :func:`envelope_functions`' factor: the band, then two numbers per column."""
+    return n * (2 * bw + 3)
+
+
+def envelope_source(n: int, bw: int) -> str:
+    """The C source of :func:`envelope_functions`."""
+    lu, solve = envelope_names(n, bw)
+    return _ENVELOPE.format(n=n, bw=bw, lu=lu, solve=solve, band=n * (2 * bw + 1), size=envelope_size(n, bw))
+
+
+@lru_cache(maxsize=8)
+def envelope_functions(n: int, bw: int) -> tuple[ca.Function, ca.Function]:
+    """``(lu, solve)`` as :func:`band_functions`, on a column-major band (``a[i][j]`` at
+    ``j (2 bw + 1) + i - j + bw``) and over its envelope: ``band -> factor`` (the LU, then
+    per column the last row of L and the first row of U that the values reach, a factor of
+    :func:`envelope_size`) and ``(factor, b) -> x``.
+
+    Why: the solve of a line's step (a few Newton iterations a step, each a solve) streams the
+    factor from memory; column-major, each column's entries are contiguous (the row-major
+    band's solve reads one number per cache line), and a band ordered by reverse
+    Cuthill-McKee holds half of its width on average (the widest rows set the bandwidth):
+    the envelope is about half the band. The operations on each entry are the row-major
+    kernels', in the same order: the same numbers, bit for bit."""
+    lu, solve = envelope_names(n, bw)
+    target = _library(envelope_source(n, bw))
     return ca.external(lu, str(target)), ca.external(solve, str(target))
 
 
@@ -271,6 +389,8 @@ def include_in(c_path: Path) -> Path:
     parts = [text]
     for n, bw in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_band_(?:lu|solve)_(\d+)_(\d+)\(", text)}):
         parts.append(source(n, bw))
+    for n, bw in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_envband_(?:lu|solve)_(\d+)_(\d+)\(", text)}):
+        parts.append(envelope_source(n, bw))
     for m, n in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_matvec_(\d+)_(\d+)\(", text)}):
         parts.append(matvec_source(m, n))
     for size, at, n in sorted({tuple(map(int, g)) for g in re.findall(r"symcat_store_(\d+)_(\d+)_(\d+)\(", text)}):
