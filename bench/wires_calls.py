@@ -1,5 +1,6 @@
 """Time of the compiled line steps alone: after a run of a case of :mod:`bench.wires_speed`
-(its library compiled), repeated compiled calls of 32 steps from the run's last state.
+(its library compiled), repeated compiled calls from the run's last state, of the run's
+steps per call (``$PER`` to set it; the runs' output interval is one step).
 Prints the median and the least CPU ms per step over ``repeats`` calls (the least: the
 machine is shared). Usage:
 python -m bench.wires_calls CASE [repeats] [seconds to keep calling, for a profiler]"""
