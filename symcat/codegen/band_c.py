@@ -1,5 +1,9 @@
 """The LU factorization without pivoting of a band matrix and its solve as C loops, for the
-compiled generalized-alpha steps (:mod:`symcat.integrate.bordered_band`).
+compiled generalized-alpha steps (:mod:`symcat.integrate.bordered_band`; row-major,
+:func:`band_functions`, or column-major over the envelope, :func:`envelope_functions`, which
+the steps use); with the other hand-written kernels of those steps: dense products
+(:func:`matvec`), stores into the caller's memory (:func:`store_function`), the wires'
+constant symmetric products (:func:`symv`) and scatter-adds by index (:func:`scatter`).
 
 Why: as CasADi SX graphs both are straight-line code, one instruction per operation: for a
 wire of 60 cable elements (360 unknowns, half-bandwidth 11) 1.5 MB of machine code for the
@@ -9,10 +13,10 @@ a few hundred bytes and do the same operations in the same order (the same resul
 bit: a structurally zero entry that the graph leaves out is a zero here, and subtracting a
 product with a zero changes nothing).
 
-The functions are external to CasADi: :func:`band_functions` compiles them into a small
-library of their own (cached, for graphs evaluated in Python) and gives their C source, which
-code generated from a graph that calls them must include (:func:`source`): CasADi's generated
-code declares and calls them by name.
+The functions are external to CasADi: each is compiled into a small library of its own
+(cached, for graphs evaluated in Python), and code generated from a graph that calls them
+must include their C source (:func:`include_in` appends it): CasADi's generated code declares
+and calls them by name.
 """
 from __future__ import annotations
 
