@@ -1,5 +1,9 @@
 """The LU factorization without pivoting of a band matrix and its solve as C loops, for the
-compiled generalized-alpha steps (:mod:`symcat.integrate.bordered_band`).
+compiled generalized-alpha steps (:mod:`symcat.integrate.bordered_band`; row-major,
+:func:`band_functions`, or column-major over the envelope, :func:`envelope_functions`, which
+the steps use); with the other hand-written kernels of those steps: dense products
+(:func:`matvec`), stores into the caller's memory (:func:`store_function`), the wires'
+constant symmetric products (:func:`symv`) and scatter-adds by index (:func:`scatter`).
 
 Why: as CasADi SX graphs both are straight-line code, one instruction per operation: for a
 wire of 60 cable elements (360 unknowns, half-bandwidth 11) 1.5 MB of machine code for the
@@ -9,10 +13,10 @@ a few hundred bytes and do the same operations in the same order (the same resul
 bit: a structurally zero entry that the graph leaves out is a zero here, and subtracting a
 product with a zero changes nothing).
 
-The functions are external to CasADi: :func:`band_functions` compiles them into a small
-library of their own (cached, for graphs evaluated in Python) and gives their C source, which
-code generated from a graph that calls them must include (:func:`source`): CasADi's generated
-code declares and calls them by name.
+The functions are external to CasADi: each is compiled into a small library of its own
+(cached, for graphs evaluated in Python), and code generated from a graph that calls them
+must include their C source (:func:`include_in` appends it): CasADi's generated code declares
+and calls them by name.
 """
 from __future__ import annotations
 
@@ -23,6 +27,7 @@ from functools import lru_cache
 from pathlib import Path
 
 import casadi as ca
+import numpy as np
 
 from .library import build_library, cached_library, find_compiler
 
@@ -92,6 +97,170 @@ const casadi_int* {solve}_sparsity_in(casadi_int i) {{ return i == 0 ? {lu}_sp :
 const casadi_int* {solve}_sparsity_out(casadi_int i) {{ return {solve}_sp; }}
 """
 
+
+
+_ENVELOPE = r"""
+/* symcat envelope band kernels: n = {n}, half-bandwidth {bw} (symcat.codegen.band_c) */
+#ifndef casadi_real
+#define casadi_real double
+#endif
+#ifndef casadi_int
+#define casadi_int long long int
+#endif
+static const casadi_int {lu}_sp[2][3] = {{{{{band}, 1, 1}}, {{{size}, 1, 1}}}};
+static const casadi_int {solve}_sp[] = {{{n}, 1, 1}};
+
+/* band -> factor: column-major band storage, a[i][j] at j (2 bw + 1) + i - j + bw; L unit
+   lower below the diagonal, U on and above it; then per column k the last row of L's column
+   (last[k]) and the first row of U's (top[k]), as numbers. Only the envelope is visited: row
+   i from its first nonzero, column j from its first nonzero (from the values: an entry that
+   is zero outside them stays zero, its products with the pivots' rows and columns zeros). */
+int {lu}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
+  const casadi_int n = {n}, bw = {bw}, wd = 2 * {bw} + 1;
+  casadi_int i, j, k, lo, end, right;
+  casadi_real *a = res[0], *last, *top, inv, ukj;
+  casadi_real *restrict ck, *restrict cj;
+  if (!a) return 0;
+  last = a + n * wd, top = last + n;
+  for (i = 0; i < n * wd; ++i) a[i] = arg[0] ? arg[0][i] : 0;
+  for (k = 0; k < n; ++k) last[k] = top[k] = k;
+  for (j = 0; j < n; ++j) {{  /* the first nonzero of column j above the diagonal */
+    for (i = j - bw > 0 ? j - bw : 0; i < j; ++i) if (a[j * wd + i - j + bw] != 0) break;
+    top[j] = i;
+  }}
+  for (i = 0; i < n; ++i) {{  /* row i's first nonzero left of the diagonal: L's columns reach row i */
+    for (lo = i - bw > 0 ? i - bw : 0; lo < i; ++lo) if (a[lo * wd + i - lo + bw] != 0) break;
+    for (k = lo; k < i; ++k) last[k] = i;  /* (i increasing: the last such row) */
+  }}
+  for (k = 0; k < n; ++k) {{
+    end = (casadi_int) last[k] + 1;
+    for (right = k, j = k + 1; j < n && j <= k + bw; ++j) if ((casadi_int) top[j] <= k) right = j;
+    ck = a + k * wd + bw - k;  /* column k: a[i][k] at ck[i] */
+    inv = 1 / ck[k];
+    for (i = k + 1; i < end; ++i) ck[i] *= inv;
+    for (j = k + 1; j <= right; ++j) {{
+      cj = a + j * wd + bw - j;
+      ukj = cj[k];
+      for (i = k + 1; i < end; ++i) cj[i] -= ck[i] * ukj;
+    }}
+  }}
+  return 0;
+}}
+
+/* (factor, b) -> x: L z = b, then U x = z, by columns (each column's entries contiguous, its
+   updates independent) over the envelope */
+int {solve}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
+  const casadi_int n = {n}, bw = {bw}, wd = 2 * {bw} + 1;
+  casadi_int i, j, end;
+  const casadi_real *restrict lu = arg[0], *restrict b = arg[1], *last, *top, *restrict cj;
+  casadi_real *restrict x = res[0], xj;
+  if (!x) return 0;
+  for (i = 0; i < n; ++i) x[i] = b ? b[i] : 0;
+  if (!lu) return 0;
+  last = lu + n * wd, top = last + n;
+  for (j = 0; j < n; ++j) {{
+    cj = lu + j * wd + bw - j;
+    xj = x[j];
+    end = (casadi_int) last[j] + 1;
+    for (i = j + 1; i < end; ++i) x[i] -= cj[i] * xj;
+  }}
+  for (j = n - 1; j >= 0; --j) {{
+    cj = lu + j * wd + bw - j;
+    xj = x[j] /= cj[j];
+    for (i = (casadi_int) top[j]; i < j; ++i) x[i] -= cj[i] * xj;
+  }}
+  return 0;
+}}
+
+casadi_int {lu}_n_in(void) {{ return 1; }}
+casadi_int {lu}_n_out(void) {{ return 1; }}
+const casadi_int* {lu}_sparsity_in(casadi_int i) {{ return {lu}_sp[0]; }}
+const casadi_int* {lu}_sparsity_out(casadi_int i) {{ return {lu}_sp[1]; }}
+casadi_int {solve}_n_in(void) {{ return 2; }}
+casadi_int {solve}_n_out(void) {{ return 1; }}
+const casadi_int* {solve}_sparsity_in(casadi_int i) {{ return i == 0 ? {lu}_sp[1] : {solve}_sp; }}
+const casadi_int* {solve}_sparsity_out(casadi_int i) {{ return {solve}_sp; }}
+"""
+
+
+_SYMV = r"""
+/* symcat symmetric products: y = A_1 x_1 + ... + A_{k} x_{k}, the A constant symmetric n = {n}
+   matrices of one pattern: their diagonals (n x {k}, per row its k numbers), their strictly
+   upper triangle by rows (row pointers n + 1, columns, values nnz x {k}; indices as numbers)
+   (symcat.codegen.band_c) */
+#ifndef casadi_real
+#define casadi_real double
+#endif
+#ifndef casadi_int
+#define casadi_int long long int
+#endif
+static const casadi_int {name}_sp[6][3] = {{{{{n1}, 1, 1}}, {{{nnz}, 1, 1}}, {{{knnz}, 1, 1}}, {{{kn}, 1, 1}}, {{{kn}, 1, 1}}, {{{n}, 1, 1}}}};
+
+int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
+  const casadi_int n = {n}, k = {k};
+  const casadi_real *restrict ptr = arg[0], *restrict col = arg[1], *restrict val = arg[2], *restrict dia = arg[3],
+                    *restrict x = arg[4];
+  casadi_real *restrict y = res[0], acc, xi[{k}];
+  casadi_int i, e, j, m, end;
+  if (!y) return 0;
+  for (i = 0; i < n; ++i) y[i] = 0;
+  if (!ptr || !col || !val || !dia || !x) return 0;
+  for (i = 0; i < n; ++i) {{
+    acc = 0;
+    for (m = 0; m < k; ++m) {{
+      xi[m] = x[m * n + i];
+      acc += dia[i * k + m] * xi[m];
+    }}
+    end = (casadi_int) ptr[i + 1];
+    for (e = (casadi_int) ptr[i]; e < end; ++e) {{
+      j = (casadi_int) col[e];
+      for (m = 0; m < k; ++m) {{
+        acc += val[e * k + m] * x[m * n + j];
+        y[j] += val[e * k + m] * xi[m];
+      }}
+    }}
+    y[i] += acc;
+  }}
+  return 0;
+}}
+
+casadi_int {name}_n_in(void) {{ return 5; }}
+casadi_int {name}_n_out(void) {{ return 1; }}
+const casadi_int* {name}_sparsity_in(casadi_int i) {{ return {name}_sp[i]; }}
+const casadi_int* {name}_sparsity_out(casadi_int i) {{ return {name}_sp[5]; }}
+"""
+
+
+_SCATTER = r"""
+/* symcat scatter-add: y[index[e]] += v[e] (index -1: left out), {m} numbers into {n}
+   (symcat.codegen.band_c) */
+#ifndef casadi_real
+#define casadi_real double
+#endif
+#ifndef casadi_int
+#define casadi_int long long int
+#endif
+static const casadi_int {name}_sp[3][3] = {{{{{m}, 1, 1}}, {{{m}, 1, 1}}, {{{n}, 1, 1}}}};
+
+int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
+  casadi_int e, i;
+  const casadi_real *restrict index = arg[0], *restrict v = arg[1];
+  casadi_real *restrict y = res[0];
+  if (!y) return 0;
+  for (i = 0; i < {n}; ++i) y[i] = 0;
+  if (!index || !v) return 0;
+  for (e = 0; e < {m}; ++e) {{
+    i = (casadi_int) index[e];
+    if (i >= 0) y[i] += v[e];
+  }}
+  return 0;
+}}
+
+casadi_int {name}_n_in(void) {{ return 2; }}
+casadi_int {name}_n_out(void) {{ return 1; }}
+const casadi_int* {name}_sparsity_in(casadi_int i) {{ return {name}_sp[i]; }}
+const casadi_int* {name}_sparsity_out(casadi_int i) {{ return {name}_sp[2]; }}
+"""
 
 _MATVEC = r"""
 /* symcat dense product: y = A x, A {m} x {n} column-major (symcat.codegen.band_c) */
@@ -175,6 +344,40 @@ def band_functions(n: int, bw: int) -> tuple[ca.Function, ca.Function]:
     return ca.external(lu, str(target)), ca.external(solve, str(target))
 
 
+def envelope_names(n: int, bw: int) -> tuple[str, str]:
+    """The C names of :func:`envelope_functions`' factorization and solve."""
+    return f"symcat_envband_lu_{n}_{bw}", f"symcat_envband_solve_{n}_{bw}"
+
+
+def envelope_size(n: int, bw: int) -> int:
+    """The size of :func:`envelope_functions`' factor: the band, then two numbers per column."""
+    return n * (2 * bw + 3)
+
+
+def envelope_source(n: int, bw: int) -> str:
+    """The C source of :func:`envelope_functions`."""
+    lu, solve = envelope_names(n, bw)
+    return _ENVELOPE.format(n=n, bw=bw, lu=lu, solve=solve, band=n * (2 * bw + 1), size=envelope_size(n, bw))
+
+
+@lru_cache(maxsize=8)
+def envelope_functions(n: int, bw: int) -> tuple[ca.Function, ca.Function]:
+    """``(lu, solve)`` as :func:`band_functions`, on a column-major band (``a[i][j]`` at
+    ``j (2 bw + 1) + i - j + bw``) and over its envelope: ``band -> factor`` (the LU, then
+    per column the last row of L and the first row of U that the values reach, a factor of
+    :func:`envelope_size`) and ``(factor, b) -> x``.
+
+    Why: the solve of a line's step (a few Newton iterations a step, each a solve) streams the
+    factor from memory; column-major, each column's entries are contiguous (the row-major
+    band's solve reads one number per cache line), and a band ordered by reverse
+    Cuthill-McKee holds half of its width on average (the widest rows set the bandwidth):
+    the envelope is about half the band. The operations on each entry are the row-major
+    kernels', in the same order: the same numbers, bit for bit."""
+    lu, solve = envelope_names(n, bw)
+    target = _library(envelope_source(n, bw))
+    return ca.external(lu, str(target)), ca.external(solve, str(target))
+
+
 def matvec_source(m: int, n: int) -> str:
     """The C source of ``symcat_matvec_<m>_<n>``: ``(A, x) -> A x``."""
     return _MATVEC.format(name=f"symcat_matvec_{m}_{n}", m=m, n=n, size=m * n)
@@ -188,6 +391,66 @@ def matvec(m: int, n: int) -> ca.Function:
     whose store and reload set its speed: six microseconds for the 360 x 10 and 11 x 360
     products of a step's solve on the moving load, as long as the band's solve)."""
     return ca.external(f"symcat_matvec_{m}_{n}", str(_library(matvec_source(m, n))))
+
+
+def symv_source(n: int, nnz: int, k: int) -> str:
+    """The C source of ``symcat_symv_<n>_<nnz>_<k>`` (:func:`symv`)."""
+    return _SYMV.format(name=f"symcat_symv_{n}_{nnz}_{k}", n=n, nnz=nnz, k=k, n1=n + 1, knnz=k * nnz, kn=k * n)
+
+
+@lru_cache(maxsize=32)
+def symv(n: int, nnz: int, k: int) -> ca.Function:
+    """``(pointers, columns, values, diagonals, x) -> A_1 x_1 + ... + A_k x_k`` for ``k``
+    symmetric ``n x n`` matrices of one pattern (:func:`symmetric_pattern`; ``x`` the ``x_m``
+    stacked), as a CasADi external.
+
+    Why: the wires' rows of a compiled step multiply the constant mass, Rayleigh and (linearized
+    wires) stiffness matrices in every Newton iteration; as CasADi's sparse products each reads
+    its whole pattern (an index and a value per entry) and adds into memory. Here one pass over
+    the upper triangle serves both triangles and all the matrices: half the entries, one index
+    per entry for all of them, the row's sum in a register."""
+    return ca.external(f"symcat_symv_{n}_{nnz}_{k}", str(_library(symv_source(n, nnz, k))))
+
+
+def symmetric_pattern(matrices, tol: float = 1e-12):
+    """The inputs of :func:`symv` for ``matrices`` (SciPy sparse, square, one size): ``(pointers,
+    columns, values, diagonals)`` as NumPy arrays, or None if one is not symmetric (to ``tol``
+    of its largest entry; each is taken as its symmetric part) or their upper triangles are
+    empty."""
+    import scipy.sparse as sps
+
+    mats = [sps.csr_matrix(m, dtype=float) for m in matrices]
+    for m in mats:
+        scale = abs(m).max() if m.nnz else 0.0
+        if m.nnz and abs(m - m.T).max() > tol * scale:
+            return None
+    mats = [0.5 * (m + m.T) for m in mats]
+    upper = [sps.triu(m, 1, format="csr") for m in mats]
+    pattern = sum(abs(u) for u in upper)
+    pattern = sps.csr_matrix((np.ones(pattern.nnz), pattern.indices, pattern.indptr), shape=pattern.shape)
+    pattern.sort_indices()
+    if not pattern.nnz:
+        return None
+    rows = np.repeat(np.arange(pattern.shape[0]), np.diff(pattern.indptr))
+    values = np.stack([np.asarray(u[rows, pattern.indices]).ravel() for u in upper], axis=1)
+    diagonals = np.stack([m.diagonal() for m in mats], axis=1)
+    return (pattern.indptr.astype(float), pattern.indices.astype(float), values.ravel(), diagonals.ravel())
+
+
+def scatter_source(n: int, m: int) -> str:
+    """The C source of ``symcat_scatter_<n>_<m>`` (:func:`scatter`)."""
+    return _SCATTER.format(name=f"symcat_scatter_{n}_{m}", n=n, m=m)
+
+
+@lru_cache(maxsize=32)
+def scatter(n: int, m: int) -> ca.Function:
+    """``(index, v) -> y``: ``y`` (``n`` numbers) the sum of the ``m`` numbers ``v`` at their
+    places ``index`` (numbers; -1 none), in their order.
+
+    Why: as a product with a sparse 0/1 matrix (CasADi's form of a scatter-add) its constant
+    data is two integers per entry and its ones are written at every call; here one number per
+    entry. The sums are the product's, in the same order."""
+    return ca.external(f"symcat_scatter_{n}_{m}", str(_library(scatter_source(n, m))))
 
 
 def store_source(size: int, at: int, n: int) -> str:
@@ -271,9 +534,15 @@ def include_in(c_path: Path) -> Path:
     parts = [text]
     for n, bw in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_band_(?:lu|solve)_(\d+)_(\d+)\(", text)}):
         parts.append(source(n, bw))
+    for n, bw in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_envband_(?:lu|solve)_(\d+)_(\d+)\(", text)}):
+        parts.append(envelope_source(n, bw))
     for m, n in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_matvec_(\d+)_(\d+)\(", text)}):
         parts.append(matvec_source(m, n))
     for size, at, n in sorted({tuple(map(int, g)) for g in re.findall(r"symcat_store_(\d+)_(\d+)_(\d+)\(", text)}):
         parts.append(store_source(size, at, n))
+    for n, nnz, k in sorted({tuple(map(int, g)) for g in re.findall(r"symcat_symv_(\d+)_(\d+)_(\d+)\(", text)}):
+        parts.append(symv_source(n, nnz, k))
+    for n, m in sorted({(int(a), int(b)) for a, b in re.findall(r"symcat_scatter_(\d+)_(\d+)\(", text)}):
+        parts.append(scatter_source(n, m))
     c_path.write_text("".join(parts))
     return c_path

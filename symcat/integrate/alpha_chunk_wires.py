@@ -7,13 +7,16 @@ the wires' rows and Jacobian are straight-line code over every element; on a cat
 hundreds of elements that is tens of megabytes of C and minutes of compiler time. Here they are
 built from the pieces the Python steps evaluate (:class:`.alpha_bulk.Bulk`):
 
-- the constant mass and Rayleigh matrices (and the stiffness of linearized wires) as sparse
-  constants: a product with one is a loop over its sparsity arrays;
+- the constant mass and Rayleigh matrices (and the stiffness of linearized wires), symmetric,
+  multiplied in one pass over their common upper triangle (:func:`~symcat.codegen.band_c.symv`:
+  half the entries, one index for all of them; a Newton iteration's largest cost after the
+  band's solve); a matrix that is not symmetric as a CasADi sparse product;
 - the element forces and stiffness, and the force elements between nodes (droppers, supports)
   with their derivatives, as the kernels' SX functions mapped over the elements (a serial map:
   a loop calling the kernel's code once per element);
 - gathered from the unknowns and scattered into the rows and the Jacobian's nonzeros with
-  constant index arrays and sparse 0/1 matrices.
+  constant index arrays (:func:`~symcat.codegen.band_c.scatter`: a sparse 0/1 matrix would be
+  two integers of constant data per entry, the Jacobian's hundreds of thousands).
 
 The rows are those of :func:`.alpha_bulk.bulk_rows` and the Jacobian their derivative in the
 bulk's pattern (``c_m M + gamma h D + beta h^2 K`` plus the force elements' terms): the same
@@ -27,6 +30,7 @@ import numpy as np
 import scipy.sparse as sps
 
 from ..assembly.sparse import to_casadi_sparse, to_scipy
+from ..codegen.band_c import scatter, symmetric_pattern, symv
 from ..codegen.library import kernel_library
 from ..scene.loads import SlopeMoment
 from .alpha_bulk import step_data
@@ -89,24 +93,22 @@ class _Gather:
     def rates(self, v_b: ca.MX) -> ca.MX:
         return ca.reshape(ca.vertcat(v_b, 0)[self._v_from], self.n_loc, self.n)
 
-    def vector_scatter(self, n_b: int) -> sps.csc_matrix:
-        """``n_b x (N n_loc)``: the local rows (stacked call after call) added to the unknowns'."""
-        rows = self.at.ravel()
-        cols = np.arange(rows.size)
-        keep = rows >= 0
-        return sps.csc_matrix((np.ones(keep.sum()), (rows[keep], cols[keep])), shape=(n_b, rows.size))
+    def vector_index(self) -> np.ndarray:
+        """The unknown each local row adds to (stacked call after call; -1 none), as numbers."""
+        return self.at.ravel().astype(float)
 
-    def matrix_scatter(self, position_of) -> sps.csc_matrix:
-        """``nnz x (N n_loc^2)``: the local matrices' entries (each call's ``n_loc x n_loc``
-        column-major, call after call) added to the Jacobian's nonzeros (``position_of(rows,
-        cols)``: their places in its pattern)."""
+    def matrix_index(self, position_of) -> np.ndarray:
+        """The Jacobian's nonzero each local matrix entry adds to (each call's ``n_loc x n_loc``
+        column-major, call after call; ``position_of(rows, cols)``: places in its pattern; -1
+        none), as numbers."""
         n, m = self.n, self.n_loc
         i, j = np.meshgrid(np.arange(m), np.arange(m), indexing="ij")  # local row, column
         src = (np.arange(n)[:, None, None] * m * m + j[None] * m + i[None]).ravel()
         rows, cols = self.at[:, i].ravel(), self.at[:, j].ravel()
         keep = (rows >= 0) & (cols >= 0)
-        pos = position_of(rows[keep], cols[keep])
-        return sps.csc_matrix((np.ones(keep.sum()), (pos, src[keep])), shape=(position_of.nnz, n * m * m))
+        index = np.full(n * m * m, -1.0)
+        index[src[keep]] = position_of(rows[keep], cols[keep])
+        return index
 
 
 class _Pattern:
@@ -180,10 +182,14 @@ class LoopedWires:
             if keep.any():
                 self._calls.append(("force", lib, lib, _Gather(rows[keep], y_of_q, q_fixed, n_b),
                                     ca.DM(params[keep].T)))
-        self._f_scatter = to_casadi_sparse(sps.hstack([g.vector_scatter(n_b) for *_, g, _ in self._calls]
-                                                      or [sps.csc_matrix((n_b, 0))]).tocsc())
-        self._j_scatter = to_casadi_sparse(sps.hstack([g.matrix_scatter(where) for *_, g, _ in self._calls]
-                                                      or [sps.csc_matrix((where.nnz, 0))]).tocsc())
+        # the scatters' places: of each local entry (call after call) in the rows, and of each
+        # local matrix entry in the Jacobian's nonzeros (-1: none)
+        self._f_index = np.concatenate([g.vector_index() for *_, g, _ in self._calls] or [np.zeros(0)])
+        self._j_index = np.concatenate([g.matrix_index(where) for *_, g, _ in self._calls] or [np.zeros(0)])
+        # the constant products: M (c_m e + beta h^2 b) + D beta h^2 v (+ K beta h^2 y, linear wires)
+        constant = [bulk.mass_matrix] + ([bulk.rayleigh] if self._rayleigh is not None else []) + (
+            [k_b] if affine is not None else [])
+        self._symmetric = symmetric_pattern(constant)
         self.pattern = pattern
 
     def functions(self) -> tuple[ca.Function, ca.Function]:
@@ -203,12 +209,18 @@ class LoopedWires:
     def rows(self, y_b, p, shift_b) -> ca.MX:
         """``beta h^2 (M (c_m a + b) + D v - f)``, ``f`` the wires' forces but damping."""
         e, v_b, b, t, bh2, gh, cm = self._state(y_b, p, shift_b)
-        r = ca.mtimes(self._mass, cm * e + bh2 * b)
-        if self._rayleigh is not None:
-            r = r + ca.mtimes(self._rayleigh, bh2 * v_b)
         f = ca.DM(self._constant)
-        if self._stiffness is not None:
-            f = f - ca.mtimes(self._stiffness, y_b)
+        if self._symmetric is not None:  # one pass over the constant matrices' upper triangle
+            x = [cm * e + bh2 * b] + ([bh2 * v_b] if self._rayleigh is not None else []) + (
+                [bh2 * y_b] if self._stiffness is not None else [])  # (K y_b: -f's, times beta h^2)
+            pointers, columns, values, diagonals = (ca.DM(a) for a in self._symmetric)
+            r = symv(self.n_b, columns.numel(), len(x))(pointers, columns, values, diagonals, ca.vertcat(*x))
+        else:
+            r = ca.mtimes(self._mass, cm * e + bh2 * b)
+            if self._rayleigh is not None:
+                r = r + ca.mtimes(self._rayleigh, bh2 * v_b)
+            if self._stiffness is not None:
+                f = f - ca.mtimes(self._stiffness, y_b)
         local = []
         for kind, name, lib, gather, params in self._calls:
             kernels, q = kernel_library(lib), gather.positions(y_b)
@@ -220,7 +232,7 @@ class LoopedWires:
                     out = out + kernels[f"{name}_damping"].map(gather.n)(q, gather.rates(v_b), params)
             local.append(ca.vec(ca.densify(out)))
         if local:
-            f = f + ca.mtimes(self._f_scatter, ca.vertcat(*local))
+            f = f + scatter(self.n_b, self._f_index.size)(ca.DM(self._f_index), ca.vertcat(*local))
         return r - bh2 * f
 
     def jacobian(self, y_b, p, shift_b) -> ca.MX:
@@ -243,7 +255,7 @@ class LoopedWires:
                     block = block + bh2 * d + gh * c
             local.append(ca.vec(ca.densify(block)))
         if local:
-            nz = nz + ca.mtimes(self._j_scatter, ca.vertcat(*local))
+            nz = nz + scatter(self.pattern.nnz(), self._j_index.size)(ca.DM(self._j_index), ca.vertcat(*local))
         return ca.sparsity_cast(nz, self.pattern)
 
 

@@ -10,7 +10,10 @@ columns. Factorized as
     [F  D]   S = D - F B^-1 E (dense, small: solved through its QR),
 
 the cost is O(n b^2) and every index is known when the code is generated: the band's
-factorization and solves are C loops over its fixed layout (:mod:`symcat.codegen.band_c`), the
+factorization and solves are C loops over its fixed layout (:mod:`symcat.codegen.band_c`;
+column-major, over the envelope the values reach: a band ordered by reverse Cuthill-McKee
+holds about half its width on average, and the solves, a line's largest cost, stream the
+factor from memory), the
 border's gathers and products straight-line code, with no sparse bookkeeping at run time. Without pivoting the band must not
 need it: the wires' block of a generalized-alpha step is ``c_m M + gamma h D + beta h^2 K``
 plus small constraint terms, positive definite in practice; a zero or tiny pivot shows as a
@@ -23,7 +26,7 @@ import numpy as np
 from scipy.sparse import csr_matrix, identity
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-from ..codegen.band_c import band_functions, matvec
+from ..codegen.band_c import envelope_functions, envelope_size, matvec
 
 
 class BorderedBand:
@@ -64,11 +67,12 @@ class BorderedBand:
         i, j = where[rows[in_b]], where[cols[in_b]]
         self.bw = int(np.max(np.abs(i - j))) if i.size else 0
         w = 2 * self.bw + 1
-        # Gathers from the matrix's nonzeros (index nnz: a zero) into the band (row-major,
-        # a[i, j] at i * w + j - i + bw), the border E (n_b x n_r), F (n_r x n_b) and D.
+        # Gathers from the matrix's nonzeros (index nnz: a zero) into the band (column-major,
+        # a[i, j] at j * w + i - j + bw: see band_c.envelope_functions), the border E
+        # (n_b x n_r), F (n_r x n_b) and D.
         zero = self.nnz
         self.band_from = np.full(n_b * w, zero)
-        self.band_from[i * w + j - i + self.bw] = np.flatnonzero(in_b)
+        self.band_from[j * w + i - j + self.bw] = np.flatnonzero(in_b)
         self.e_from = np.full((n_b, self.n_r), zero)
         self.f_from = np.full((self.n_r, n_b), zero)
         self.d_from = np.full((self.n_r, self.n_r), zero)
@@ -78,12 +82,12 @@ class BorderedBand:
         self.f_from[rows[f] - n_b, where[cols[f]]] = np.flatnonzero(f)
         d = (rows >= n_b) & (cols >= n_b)
         self.d_from[rows[d] - n_b, cols[d] - n_b] = np.flatnonzero(d)
-        self.band_entries = n_b * w
+        self.band_entries = envelope_size(n_b, self.bw) if n_b else 0  # the band's LU and its envelope
         # the couplings that can be nonzero: E's columns e_cols, F's rows f_rows
         self.e_from, self.f_from = self.e_from[:, self.e_cols], self.f_from[self.f_rows, :]
         # the factor: LU of the band, X = B^-1 E (n_b x n_e), F (n_f x n_b), S^-1
         self.n_e, self.n_f = self.e_cols.size, self.f_rows.size
-        self.size = n_b * w + n_b * (self.n_e + self.n_f) + self.n_r**2
+        self.size = self.band_entries + n_b * (self.n_e + self.n_f) + self.n_r**2
 
     # --- graphs -----------------------------------------------------------------------------
     def factorize(self, nonzeros: ca.MX) -> ca.MX:
@@ -95,7 +99,7 @@ class BorderedBand:
         def gather(index):
             return values[index.ravel(order="F").tolist()]
 
-        lu = band_functions(n_b, self.bw)[0](gather(self.band_from)) if n_b else ca.MX(0, 1)
+        lu = envelope_functions(n_b, self.bw)[0](gather(self.band_from)) if n_b else ca.MX(0, 1)
         return self._with_border(lu, gather) if n_r else lu
 
     def refactorize_border(self, factor: ca.MX, nonzeros: ca.MX) -> ca.MX:
@@ -122,7 +126,7 @@ class BorderedBand:
         f = ca.reshape(gather(self.f_from), n_f, n_b)
         d = ca.reshape(gather(self.d_from), n_r, n_r)
         # a call per column, not a map: a map's code copies the LU it shares once per column
-        solve = band_functions(n_b, self.bw)[1]
+        solve = envelope_functions(n_b, self.bw)[1]
         x = ca.horzcat(*(solve(lu, e[:, j]) for j in range(n_e))) if n_b and n_e else ca.MX(n_b, n_e)
         s = ca.MX(d)
         if n_e and n_f:
@@ -133,13 +137,13 @@ class BorderedBand:
 
     def solve(self, factor: ca.MX, rhs: ca.MX) -> ca.MX:
         """``A^-1 rhs`` from :meth:`factorize`'s factor."""
-        n_b, n_r, w = self.n_b, self.n_r, 2 * self.bw + 1
-        lu = factor[: n_b * w]
+        n_b, n_r = self.n_b, self.n_r
+        lu = factor[: self.band_entries]
         perm = self.perm.tolist()
-        z = band_functions(n_b, self.bw)[1](lu, rhs[perm]) if n_b else ca.MX(0, 1)
+        z = envelope_functions(n_b, self.bw)[1](lu, rhs[perm]) if n_b else ca.MX(0, 1)
         if n_r:
             n_e, n_f = self.n_e, self.n_f
-            at = n_b * w
+            at = self.band_entries
             x = factor[at : at + n_b * n_e]  # (n_b x n_e, column-major)
             f = factor[at + n_b * n_e : at + n_b * (n_e + n_f)]  # (n_f x n_b)
             s_inv = ca.reshape(factor[at + n_b * (n_e + n_f) :], n_r, n_r)
