@@ -30,7 +30,7 @@ def main(case: str) -> None:
 
     ac.CompiledSteps.__init__ = init_
     try:
-        run_model("benchmark2015", dict(CASES[case], pantograph="lumped_scene", progress=False, paraview=False))
+        run_model("benchmark2015", dict(CASES[case], progress=False, paraview=False))
     except BaseException:
         pass
     integ = captured["cs"].integ
@@ -42,7 +42,7 @@ def main(case: str) -> None:
         return
     t0 = time.perf_counter()
     with symbolic_kernels():
-        fns = ac._chunk_functions(st, integ.coef)
+        fns = ac.chunk_functions(st, integ.coef)
     with tempfile.TemporaryDirectory() as tmp:
         c = write_c(fns, Path(tmp))
         t1 = time.perf_counter()

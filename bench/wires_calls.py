@@ -23,9 +23,9 @@ def main(case: str, repeats: int = 30, hold: float = 0.0) -> dict:
     captured = {}
     call = ac.CompiledSteps._call
 
-    def call_(self, s, t, n):
+    def call_(self, s, t, n, states=None):
         captured.update(cs=self, s=s, t=t)
-        return call(self, s, t, n)
+        return call(self, s, t, n, states)
 
     ac.CompiledSteps._call = call_
     res = run(case)

@@ -26,7 +26,7 @@ def main(case: str, folder: str) -> None:
         raise KeyboardInterrupt  # (the model is built: no need to run it)
 
     ac.CompiledSteps.__init__ = init_
-    p = dict(CASES[case], pantograph="lumped_scene", progress=False, paraview=False)
+    p = dict(CASES[case], progress=False, paraview=False)
     try:
         run_model("benchmark2015", p)
     except BaseException:
@@ -35,7 +35,7 @@ def main(case: str, folder: str) -> None:
     st = integ.stepper
     t0 = time.perf_counter()
     with symbolic_kernels():
-        fns = ac._chunk_functions(st, integ.coef)
+        fns = ac.chunk_functions(st, integ.coef)
     t1 = time.perf_counter()
     path = write_c(fns, Path(folder))
     print(f"graph {t1 - t0:.1f} s, C {time.perf_counter() - t1:.1f} s: {path} ({path.stat().st_size / 1e6:.1f} MB)")

@@ -1,4 +1,4 @@
-"""Compiled line steps of benchmark2015 (multibody path, lumped_scene pantograph): wall per
+"""Compiled line steps of benchmark2015 (multibody path, lumped pantograph): wall per
 simulated second, time in the compiled calls per step, contact force statistics, and the
 iteration matrix's band layout. Usage: python -m bench.wires_speed CASE [--layout]
 CASE: one (1 % settings), defaults, overlap. The first run in background mode compiles."""
@@ -23,7 +23,7 @@ def main(case: str, layout: bool = False) -> dict:
     from symcat.codegen.optimized import wait_for_background
     from symcat.model import run_model
 
-    p = dict(CASES[case], pantograph="lumped_scene", progress=False, paraview=False)
+    p = dict(CASES[case], progress=False, paraview=False)
     captured, timing = {}, dict(call_s=0.0, steps=0)
     init, call = ac.CompiledSteps.__init__, ac.CompiledSteps._call
 
@@ -31,9 +31,9 @@ def main(case: str, layout: bool = False) -> dict:
         init(self, integ, *a, **k)
         captured["cs"] = self
 
-    def call_(self, s, t, n):
+    def call_(self, s, t, n, states=None):
         t0 = time.thread_time()
-        out = call(self, s, t, n)
+        out = call(self, s, t, n, states)
         timing["call_s"] += time.thread_time() - t0
         timing["steps"] += out[0]
         return out
