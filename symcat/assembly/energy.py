@@ -123,44 +123,37 @@ class _ContactEnergy:
             self.contacts.append((ct, np.array(model._rigid_indices(ct.body.name)), built[ct.library],
                                   ct.params[names.index("k")], ct.params[names.index("delta")]))
 
-    def powers(self, q, v, sc) -> np.ndarray:
-        """The non-conservative power (W) of all contacts at the states of the rows of ``q``,
-        ``v`` and ``sc`` (the states after several steps: each contact's terms evaluated for
-        all of them in one call)."""
-        k = len(q)
-        power = np.zeros(k)
-        for i, (ct, rigid, terms, kk, delta) in enumerate(self.contacts):
+    def _evaluated(self, q, v, sc):
+        """Per contact on its wire at some of the states of the rows of ``q``, ``v`` and
+        ``sc``: ``(on, q_v, gap, penetration rate, k, delta)``, ``on`` the states where it is
+        (off its wire a contact has no force, as in ``contact_terms``), its terms evaluated
+        for all of them in one call."""
+        for i, (ct, rigid, terms, k, delta) in enumerate(self.contacts):
             starts, s = np.asarray(ct.element_start), sc[:, i]
-            on = (starts[0] <= s) & (s <= starts[-1])  # off its wire: no force (contact_terms)
+            on = (starts[0] <= s) & (s <= starts[-1])
             if not on.any():
                 continue
             e = np.clip(np.searchsorted(starts, s[on], side="right") - 1, 0, len(starts) - 2)
-            rows = np.asarray(ct.element_indices)[e]  # (k_on, n_local)
+            rows = np.asarray(ct.element_indices)[e]  # (states on, n_local)
             q_on, v_on = q[on], v[on]
             y = np.concatenate((np.take_along_axis(q_on, rows, 1), q_on[:, rigid], (s[on] - starts[e])[:, None]), 1)
             y_dot = np.concatenate((np.take_along_axis(v_on, rows, 1), v_on[:, rigid]), 1)
             p = np.tile(ct.params, (len(e), 1))
             p[:, 0] = starts[e + 1] - starts[e]
-            q_v, gap, pen_dot = _mapped(terms, len(e)).nonzeros(y.ravel(), y_dot.ravel(), p.ravel())
-            f_el = np.array([_penalty_scalar(-g, kk, delta)[1] for g in gap])
-            power[on] += q_v + f_el * pen_dot
+            yield (on, *_mapped(terms, len(e)).nonzeros(y.ravel(), y_dot.ravel(), p.ravel()), k, delta)
+
+    def powers(self, q, v, sc) -> np.ndarray:
+        """The non-conservative power (W) of all contacts at the states of the rows of ``q``,
+        ``v`` and ``sc`` (the states after several steps)."""
+        power = np.zeros(len(q))
+        for on, q_v, gap, pen_dot, k, delta in self._evaluated(q, v, sc):
+            power[on] += q_v + penalty_law(-gap, k, delta)[1] * pen_dot
         return power
 
     def potential(self, q, v, sc) -> float:
         """The potential (J) of all contacts at the state ``(q, v, sc)``."""
-        energy = 0.0
-        for (ct, rigid, terms, k, delta), s in zip(self.contacts, sc):
-            starts = ct.element_start
-            if not starts[0] <= s <= starts[-1]:
-                continue  # off its wire: no force (contact_terms)
-            e = min(max(int(np.searchsorted(starts, s, side="right")) - 1, 0), len(starts) - 2)
-            rows = ct.element_indices[e]
-            y = np.concatenate((q[rows], q[rigid], (s - starts[e],)))
-            p = ct.params.copy()
-            p[0] = starts[e + 1] - starts[e]
-            gap = float(terms.nonzeros(y, np.concatenate((v[rows], v[rigid])), p)[1][0])
-            energy += _penalty_scalar(-gap, k, delta)[0]
-        return energy
+        return float(sum(penalty_law(-gap, k, delta)[0].sum()
+                         for _, _, gap, _, k, delta in self._evaluated(q[None], v[None], np.asarray(sc)[None])))
 
 
 _MAPPED: dict = {}

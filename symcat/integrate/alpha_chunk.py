@@ -84,7 +84,7 @@ OPTIMIZED_FLAGS = ("-O3", "-fno-semantic-interposition", "-fPIC", "-shared")
 _SOURCE = b"".join((Path(__file__).parent / name).read_bytes()
                    for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "alpha_chunk_wires.py",
                                 "alpha_chunk_later.py", "alpha_chunk_code.py", "bordered_band.py", "alpha_proxies.py",
-                                "../codegen/band_c.py"))
+                                "../codegen/band_c.py", "../codegen/sparse_c.py"))
 
 
 class CompiledSteps:

@@ -8,14 +8,14 @@ hundreds of elements that is tens of megabytes of C and minutes of compiler time
 built from the pieces the Python steps evaluate (:class:`.alpha_bulk.Bulk`):
 
 - the constant mass and Rayleigh matrices (and the stiffness of linearized wires), symmetric,
-  multiplied in one pass over their common upper triangle (:func:`~symcat.codegen.band_c.symv`:
+  multiplied in one pass over their common upper triangle (:func:`~symcat.codegen.sparse_c.symv`:
   half the entries, one index for all of them; a Newton iteration's largest cost after the
   band's solve); a matrix that is not symmetric as a CasADi sparse product;
 - the element forces and stiffness, and the force elements between nodes (droppers, supports)
   with their derivatives, as the kernels' SX functions mapped over the elements (a serial map:
   a loop calling the kernel's code once per element);
 - gathered from the unknowns and scattered into the rows and the Jacobian's nonzeros with
-  constant index arrays (:func:`~symcat.codegen.band_c.scatter`: a sparse 0/1 matrix would be
+  constant index arrays (:func:`~symcat.codegen.sparse_c.scatter`: a sparse 0/1 matrix would be
   two integers of constant data per entry, the Jacobian's hundreds of thousands).
 
 The rows are those of :func:`.alpha_bulk.bulk_rows` and the Jacobian their derivative in the
@@ -30,7 +30,7 @@ import numpy as np
 import scipy.sparse as sps
 
 from ..assembly.sparse import to_casadi_sparse, to_scipy
-from ..codegen.band_c import scatter, symmetric_pattern, symv
+from ..codegen.sparse_c import scatter, symmetric_pattern, symv
 from ..codegen.library import kernel_library
 from ..scene.loads import SlopeMoment
 from .alpha_bulk import step_data

@@ -1,5 +1,5 @@
 """The wires' constant products and scatters of the compiled line steps
-(:func:`symcat.codegen.band_c.symv`, :func:`~symcat.codegen.band_c.scatter`, used by
+(:func:`symcat.codegen.sparse_c.symv`, :func:`~symcat.codegen.sparse_c.scatter`, used by
 :class:`symcat.integrate.alpha_chunk_wires.LoopedWires`): the products of symmetric matrices
 from one pass over their common upper triangle are the sparse products to round-off; a matrix
 that is not symmetric is not taken; the scatter-add is NumPy's, in the same order."""
@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sps
 
-from symcat.codegen.band_c import scatter, symmetric_pattern, symv
+from symcat.codegen.sparse_c import scatter, symmetric_pattern, symv
 
 
 def _symmetric(n, density, rng):
