@@ -139,6 +139,27 @@ def failed_path(library: Path) -> Path:
     return library.with_suffix(".failed")
 
 
+def compile_written(library: Path, flags: tuple, graph: Path, write) -> int:
+    """The background job of a library whose C is written from a waiting serialized graph:
+    ``write(graph, folder) -> path`` writes the C into ``folder``, then :func:`compile_waiting`
+    compiles it; the graph is removed, a failure left in :func:`failed_path` (nobody reads the
+    job's stderr) and the lock removed."""
+    import shutil
+    import tempfile
+
+    try:
+        os.nice(10)
+        with tempfile.TemporaryDirectory() as tmp:
+            shutil.move(str(write(graph, Path(tmp))), source_path(library))
+    except Exception as exc:  # noqa: BLE001 - reported in a file: nobody reads this process's stderr
+        failed_path(library).write_text(f"{type(exc).__name__}: {exc}\n")
+        lock_path(library).unlink(missing_ok=True)
+        return 1
+    finally:
+        graph.unlink(missing_ok=True)
+    return compile_waiting(library, flags)
+
+
 def compile_waiting(library: Path, flags: tuple = OPTIMIZED_FLAGS) -> int:
     """The background job: compile the waiting C into ``library`` with ``flags``, then remove
     the C and the lock (also on failure, whose message is left in :func:`failed_path`)."""

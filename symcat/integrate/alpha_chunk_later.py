@@ -11,9 +11,7 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 import casadi as ca
@@ -61,22 +59,11 @@ def _graph_path(library: Path) -> Path:
 
 def _build_library(library: Path, flags: tuple) -> int:
     """The background job of :func:`compile_later`: the waiting functions' C, then its
-    compilation (which removes the lock)."""
-    from ..codegen.optimized import compile_waiting, failed_path, lock_path, source_path
+    compilation (:func:`symcat.codegen.optimized.compile_written`)."""
+    from ..codegen.optimized import compile_written
 
-    graph = _graph_path(library)
-    try:
-        os.nice(10)
-        functions = ca.FileDeserializer(str(graph)).unpack()
-        with tempfile.TemporaryDirectory() as tmp:
-            shutil.move(str(write_c(functions, Path(tmp))), source_path(library))
-    except Exception as exc:  # noqa: BLE001 - reported in a file: nobody reads this process's stderr
-        failed_path(library).write_text(f"{type(exc).__name__}: {exc}\n")
-        lock_path(library).unlink(missing_ok=True)
-        return 1
-    finally:
-        graph.unlink(missing_ok=True)
-    return compile_waiting(library, flags)
+    return compile_written(library, flags, _graph_path(library),
+                           lambda graph, folder: write_c(ca.FileDeserializer(str(graph)).unpack(), folder))
 
 
 if __name__ == "__main__":

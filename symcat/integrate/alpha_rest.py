@@ -11,10 +11,7 @@ itself, which is why that is not done in the run."""
 from __future__ import annotations
 
 import logging
-import os
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 import casadi as ca
@@ -99,22 +96,11 @@ def compile_later(rest: ca.Function, key: bytes) -> bool:
 
 def _build_library(library: Path, flags: tuple) -> int:
     """The background job of :func:`compile_later`: the waiting graph's C, then its compilation
-    (:func:`symcat.codegen.optimized.compile_waiting`, which removes the lock)."""
-    from ..codegen.optimized import compile_waiting, failed_path, lock_path, source_path
+    (:func:`symcat.codegen.optimized.compile_written`)."""
+    from ..codegen.optimized import compile_written
 
-    graph = _graph_path(library)
-    try:
-        os.nice(10)
-        rest = ca.Function.deserialize(graph.read_text())
-        with tempfile.TemporaryDirectory() as tmp:
-            shutil.move(str(_write_c(rest, Path(tmp))), source_path(library))
-    except Exception as exc:  # noqa: BLE001 - reported in a file: nobody reads this process's stderr
-        failed_path(library).write_text(f"{type(exc).__name__}: {exc}\n")
-        lock_path(library).unlink(missing_ok=True)
-        return 1
-    finally:
-        graph.unlink(missing_ok=True)
-    return compile_waiting(library, flags)
+    return compile_written(library, flags, _graph_path(library),
+                           lambda graph, folder: _write_c(ca.Function.deserialize(graph.read_text()), folder))
 
 
 if __name__ == "__main__":
