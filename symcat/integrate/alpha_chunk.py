@@ -79,10 +79,11 @@ MAX_BORDER = 60
 #: (``casadi_sq``, used a thousand times in a step, is else a call through the symbol table).
 OPTIMIZED_FLAGS = ("-O3", "-fno-semantic-interposition", "-fPIC", "-shared")
 
-#: The code the compiled library follows from (this module, the residual, the factorization and
-#: the proxies), part of its cache key.
+#: The code the compiled library follows from (the steps' code, the residual, the factorization
+#: and the proxies; not this module, the runtime, whose edits leave the code as it was), part of
+#: its cache key.
 _SOURCE = b"".join((Path(__file__).parent / name).read_bytes()
-                   for name in ("alpha_chunk.py", "alpha_chunk_residual.py", "alpha_chunk_wires.py",
+                   for name in ("alpha_chunk_residual.py", "alpha_chunk_wires.py",
                                 "alpha_chunk_later.py", "alpha_chunk_code.py", "bordered_band.py", "alpha_proxies.py",
                                 "../codegen/band_c.py", "../codegen/sparse_c.py"))
 
@@ -203,8 +204,10 @@ class CompiledSteps:
         """The factor's storage (its size the library's), the packed state's layout and the
         Newton tolerance's scale."""
         n_u, n_c, n_sc, n_y = step_sizes(self.integ.form, self.integ.variant)
-        # the factor's memory, which the calls read and renew in place (no copies, _call)
-        self._factor = np.zeros(self._fns[LENGTHS[0]].function.nnz_in(4))
+        # the factor's memory, which the calls read and renew in place (no copies, _call); its
+        # size from the function that renews it, which every run loads (a function's loading
+        # allocates its work, tens of megabytes on a line)
+        self._factor = np.zeros(self._fns["renew"].function.nnz_out(0))
         self._cuts = packed_cuts(n_u, n_c, n_sc)[:-2]
         self._mass_scale = mass_scale
         model = self.integ.model

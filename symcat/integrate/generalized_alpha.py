@@ -87,6 +87,7 @@ from ..errors import ParameterError, SolverError
 from ..progress import Progress
 from ..run_control import check_interrupt, integrating
 from .alpha_chunk import CompiledSteps
+from .alpha_chunk_cache import one_run
 from .alpha_coefficients import AlphaCoefficients
 from .alpha_events import integrate_alpha_events
 from .alpha_integrator import Integrator, StepFailure
@@ -240,6 +241,7 @@ def integrate_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: flo
     return run
 
 
+@one_run
 def generalized_alpha(model: MultibodyModel, t_end: float, dt: float, rho_inf: float = 0.9,
                       variant: str = "stabilized", tol: float = 1e-10, max_iterations: int = 20, n_out: int = 200,
                       progress: bool = True, expand: bool = False, max_halvings: int = 4,

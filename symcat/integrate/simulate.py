@@ -32,6 +32,7 @@ from ..dae.initial import consistent_state
 from ..errors import ParameterError, SolverError
 from ..progress import Progress
 from ..run_control import check_interrupt, ended_early, integrating
+from .alpha_chunk_cache import one_run
 from .event_stepping import CallFailed, EventStepper
 from .events import EventHandler
 from .failure import failure, split_state
@@ -48,6 +49,7 @@ STAT_KEYS = ("nsteps", "nfevals", "nlinsetups", "netfails", "nniters", "nncfails
 __all__ = ["CONTACT_GROUP_S", "STAT_KEYS", "VELOCITY_ATOL_FACTOR", "IdasSettings", "simulate", "update_windows"]
 
 
+@one_run
 def simulate(model: MultibodyModel, t_end: float, formulation: str = "augmented", index: str = "1",
              settings: IdasSettings | None = None, *, handlers=None, **legacy) -> SimulationResult:
     """Simulate ``model`` from 0 to ``t_end`` seconds.

@@ -103,3 +103,27 @@ def test_step_sizes_are_the_step_equations(variant):
     form = Formulation(model, "augmented", "1")
     st = StepEquations(form, variant)
     assert step_sizes(form, variant) == (st.n_u, st.n_c, st.n_sc, st.n_y)
+
+
+def test_a_run_digests_its_scene_once(monkeypatch):
+    """Within a run (the compiled steps', the initial state's and the post-processing's keys)
+    the scene is digested once; outside a run, at every key, so that a scene changed between
+    two keys is still seen."""
+    import symcat.integrate.alpha_chunk_cache as cache
+
+    model = moving_load()
+    _run(model)  # (compiled and recorded: the counted run below takes the same path)
+    count = {"n": 0}
+    digest = cache.scene_digest
+
+    def counted(scene):
+        count["n"] += 1
+        return digest(scene)
+
+    monkeypatch.setattr(cache, "scene_digest", counted)
+    again = moving_load()
+    _run(again)
+    assert count["n"] == 1
+    assert _key(again) is not None and count["n"] == 2
+    again.scene.force_elements[0].force = (0.0, -200.0, 0.0)
+    assert _key(again) is None and count["n"] == 3
