@@ -68,7 +68,7 @@ class Proxies:
         if first is None or second is None:
             return None
         # Bulk columns of the rest that belong to no proxy: other rest terms on the wires.
-        others = set()
+        others, probes = set(), []
         for elements in (first, second):
             proxy = cls(step, items, elements)
             w = ca.MX.sym("w", 2 * len(items))
@@ -76,7 +76,9 @@ class Proxies:
             try:
                 proxy.install(w)
                 mode = step.mode_symbol
-                pattern = ca.Function("probe", [y, p, w, mode], [step._rows(y, p, mode)[0]]).sparsity_jac(0, 0)
+                rows = step._rows(y, p, mode, contacts=True)
+                pattern = ca.Function("probe", [y, p, w, mode], [rows[0]]).sparsity_jac(0, 0)
+                probes.append((w, rows, pattern))
             finally:
                 model.element_override.clear()
                 for sl, window in zip(items, saved):
@@ -87,6 +89,9 @@ class Proxies:
         proxy = cls(step, items, first)
         if others & set(y_of_q[np.concatenate([sl.element_indices[j] for sl, j in zip(items, first)])].tolist()):
             return None
+        # the rows on the chosen proxies, their symbols and their Jacobian's pattern in y, which
+        # the step builds on (the graph of a line's rows takes tens of milliseconds)
+        proxy.probe = probes[0]
         return proxy
 
     def install(self, w) -> None:

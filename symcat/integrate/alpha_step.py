@@ -96,15 +96,17 @@ class StepEquations:
         self.mode_symbol = mode = ca.MX.sym("mode", self.mode.size)
         self.proxies = Proxies.choose(self, y, p) if proxies else None
         saved = [sl.window for sl in model.windowed()]
-        w = ca.MX.sym("w", 0 if self.proxies is None else 2 * len(self.proxies.items))
+        # (on proxies: the rows the choice of proxies built, on its symbols w)
+        w, rows, pattern = self.proxies.probe if self.proxies is not None else (ca.MX.sym("w", 0), None, None)
         try:
             if self.proxies is not None:
                 self.proxies.install(w)
             # The rest depends on few unknowns: entered as a structurally sparse y, its graph and
             # Jacobian never touch the other thousands.
-            rows = self._rows(y, p, mode, contacts=True)  # built once: the graph of a vehicle takes a while
-            probe = ca.Function("alpha_rest", [y, p, w, mode], [rows[0]])
-            self.rest_columns = np.unique(np.array(probe.sparsity_jac(0, 0).get_col(), int))
+            if rows is None:
+                rows = self._rows(y, p, mode, contacts=True)  # built once: the graph of a vehicle takes a while
+                pattern = ca.Function("alpha_rest", [y, p, w, mode], [rows[0]]).sparsity_jac(0, 0)
+            self.rest_columns = np.unique(np.array(pattern.get_col(), int))
             k = self.rest_columns.size
             y_rest = ca.MX.sym("y_rest", k)
             y_sparse = ca.MX(ca.Sparsity.triplet(n_y, 1, self.rest_columns.tolist(), [0] * k), y_rest)
