@@ -14,7 +14,6 @@ SuperLU otherwise. There is no Python work per element or per nonzero.
 from __future__ import annotations
 
 import time
-import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -167,12 +166,12 @@ class _FreeNewton:
     and reused by later solves.
     """
 
-    _CACHE: "weakref.WeakKeyDictionary[System, dict]" = weakref.WeakKeyDictionary()
-
     @classmethod
     def of(cls, system: System) -> "_FreeNewton":
         free = system.dofs.free
-        per_system = cls._CACHE.setdefault(system, {})
+        # kept on the system, so that it goes with it (a weak-key table would hold it for
+        # ever: the value refers to its key)
+        per_system = system.__dict__.setdefault("_free_newton", {})
         key = free.tobytes()
         if key not in per_system:
             per_system[key] = cls(system, free)

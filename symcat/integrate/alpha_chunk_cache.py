@@ -42,9 +42,10 @@ from ..codegen.paths import PACKAGE_DIR, atomic_write, cache_dir, generated_dir,
 
 #: Version of the record's content (a change makes older records unreadable, not wrong).
 RECORD_VERSION = 2
-#: Models whose per-model functions :func:`model_memo` keeps in a process (least recently used
-#: first out; a function of a small model is tens of kilobytes, with its maps a few hundred).
-MEMO_SIZE = 32
+#: Functions :func:`model_memo` keeps in a process, two or three per model (least recently used
+#: first out; a small model's are tens to hundreds of kilobytes, a line's megabytes: a process
+#: that runs many lines, a study's worker, keeps a few models' worth).
+MEMO_SIZE = 12
 _MEMO: OrderedDict = OrderedDict()
 
 

@@ -169,3 +169,19 @@ def test_banded_and_general_sparse_newton_steps_agree(rng):
     np.testing.assert_allclose(newton.solve(jac_nz, rhs), expected, rtol=1e-8, atol=1e-14)
     newton.banded = False
     np.testing.assert_allclose(newton.solve(jac_nz, rhs), expected, rtol=1e-8, atol=1e-14)
+
+
+def test_a_solved_system_is_freed_with_its_last_reference():
+    """The static solver's set-up is kept with its system, not in a table that outlives it: a
+    process that builds and solves many systems (a study's worker, the line's form finding)
+    keeps none of them (each of a line's held some 140 MB)."""
+    import gc
+    import weakref
+
+    scene, _ = _wire("cable3d", 16, prestrain=2e-4, gravity=(0.0, 0.0, -9.81))
+    system = assemble(scene)
+    solve_static(system)
+    gone = weakref.ref(system)
+    del system
+    gc.collect()
+    assert gone() is None
