@@ -28,7 +28,6 @@ from __future__ import annotations
 import hashlib
 import json
 from collections import OrderedDict
-from contextlib import contextmanager
 from functools import lru_cache, wraps
 from pathlib import Path
 
@@ -102,19 +101,13 @@ def one_run(run):
     post-processing's: a line's scene takes 0.02 s to digest)."""
     @wraps(run)
     def wrapper(model, *args, **kwargs):
-        with _scene_checked_once(model):
+        outer = model.__dict__.get("_scene_checked")
+        model._scene_checked = "run"
+        try:
             return run(model, *args, **kwargs)
+        finally:
+            model._scene_checked = outer
     return wrapper
-
-
-@contextmanager
-def _scene_checked_once(model):
-    outer = model.__dict__.get("_scene_checked")
-    model._scene_checked = "run"
-    try:
-        yield
-    finally:
-        model._scene_checked = outer
 
 
 def _record_path(key: str) -> Path:

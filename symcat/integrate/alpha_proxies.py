@@ -43,12 +43,15 @@ class Proxies:
 
     @classmethod
     def choose(cls, step, y, p):
-        """Proxies for ``step``'s model, or None when its windows never move or no element
-        qualifies (the windows are then rebuilt as the points move)."""
+        """``(proxies, probe)`` for ``step``'s model, or ``(None, None)`` when its windows never
+        move or no element qualifies (the windows are then rebuilt as the points move).
+        ``probe``: the step's rows on the chosen proxies, their symbols ``w`` and the rows'
+        Jacobian pattern in ``y``, ``(w, rows, pattern)``, which the step builds on (the graph
+        of a line's rows takes tens of milliseconds to build)."""
         model = step.form.model
         items = model.windowed()
         if not items or not model.windows_move():
-            return None
+            return None, None
         y_of_q = np.full(model.n_q, -1)
         y_of_q[model.free] = np.arange(step.form.n_f)
 
@@ -66,7 +69,7 @@ class Proxies:
 
         first, second = candidates(0), candidates(3)
         if first is None or second is None:
-            return None
+            return None, None
         # Bulk columns of the rest that belong to no proxy: other rest terms on the wires.
         others, probes = set(), []
         for elements in (first, second):
@@ -88,11 +91,8 @@ class Proxies:
             others |= {c for c in cols - mine if c < step.bulk.n_b}
         proxy = cls(step, items, first)
         if others & set(y_of_q[np.concatenate([sl.element_indices[j] for sl, j in zip(items, first)])].tolist()):
-            return None
-        # the rows on the chosen proxies, their symbols and their Jacobian's pattern in y, which
-        # the step builds on (the graph of a line's rows takes tens of milliseconds)
-        proxy.probe = probes[0]
-        return proxy
+            return None, None
+        return proxy, probes[0]
 
     def install(self, w) -> None:
         """One-element windows on the proxies, their start and length the symbols ``w``."""

@@ -94,10 +94,10 @@ class StepEquations:
         # The open flags of the wheel/rail contacts (1: lifted off), set by an event handler.
         self.mode = np.zeros(len(model.wheelrail))
         self.mode_symbol = mode = ca.MX.sym("mode", self.mode.size)
-        self.proxies = Proxies.choose(self, y, p) if proxies else None
+        self.proxies, probe = Proxies.choose(self, y, p) if proxies else (None, None)
         saved = [sl.window for sl in model.windowed()]
         # (on proxies: the rows the choice of proxies built, on its symbols w)
-        w, rows, pattern = self.proxies.probe if self.proxies is not None else (ca.MX.sym("w", 0), None, None)
+        w, rows, pattern = probe if probe is not None else (ca.MX.sym("w", 0), None, None)
         try:
             if self.proxies is not None:
                 self.proxies.install(w)
